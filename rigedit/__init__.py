@@ -1,0 +1,49 @@
+"""rigedit: a rig editor for 3D characters (skeleton, skinning, posing, clips).
+
+>>> import rigedit
+>>> rig = rigedit.load_rig()            # the bundled quadruped
+>>> pose = rig.rest_pose()
+>>> pose.set_euler("neck_1", [0, 0, 20], degrees=True)
+>>> verts = rig.skin(pose)
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from .animation import Clip, Track
+from .errors import RigFileError
+from .model import Pose, Skeleton, SkinBinding
+from .rig import Rig
+
+__all__ = ["load_rig", "resolve_rig_path", "BUNDLED", "ASSETS_DIR", "Rig", "Skeleton", "Pose",
+           "Clip", "Track", "SkinBinding", "RigFileError"]
+__version__ = "0.1.0"
+
+#: Where the bundled characters live (the repository's assets/ folder, or $RIGEDIT_ASSETS).
+ASSETS_DIR = Path(os.environ.get("RIGEDIT_ASSETS", Path(__file__).resolve().parent.parent / "assets"))
+#: Names accepted wherever a rig is asked for; the first is the default.
+BUNDLED = ("quadruped", "humanoid")
+
+
+def resolve_rig_path(rig=None):
+    """Path of a rig folder from a bundled name, a path, or None (the default character)."""
+    if rig is None:
+        rig = BUNDLED[0]
+    if str(rig) in BUNDLED and not Path(rig).exists():
+        return ASSETS_DIR / str(rig)
+    return Path(rig)
+
+
+def load_rig(rig=None, weights_method="idw"):
+    """Load a rig folder, or a bundled character by name (``quadruped``, the default, or
+    ``humanoid``).
+
+    Raises
+    ------
+    RigFileError
+        When a file is missing or malformed; the message names the file.
+    """
+    from .io.rig_folder import load_rig_folder
+
+    return load_rig_folder(resolve_rig_path(rig), weights_method=weights_method)

@@ -1,0 +1,90 @@
+"""A rig: mesh + skeleton + skin binding + clips, with the per-frame pipeline."""
+from __future__ import annotations
+
+import numpy as np
+
+from .model.kinematics import local_to_model, skinning_matrices
+from .model.pose import Pose
+from .model.skinning import SkinBinding
+from .model.weights import compute_weights
+
+__all__ = ["Rig"]
+
+
+class Rig:
+    """A skinned character.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+    vertices : (V, 3) float64
+        Rest (bind-pose) positions, model space.
+    faces : (F, 3) int64
+    indices, weights : (V, K) arrays, optional
+        Skin influences; computed with ``weights_method`` when omitted.
+    clips : dict[str, Clip], optional
+    name : str
+    up : {"y", "z"}
+        The vertical axis (bundled characters and glTF: y; the elk format: z).
+    weights_method : str
+    """
+
+    def __init__(self, skeleton, vertices, faces, indices=None, weights=None, clips=None,
+                 name="rig", up="y", weights_method="idw", path=None):
+        self.skeleton = skeleton
+        self.vertices = np.asarray(vertices, dtype=np.float64)
+        self.faces = np.asarray(faces, dtype=np.int64)
+        self.clips = dict(clips or {})
+        self.name = name
+        self.up = up
+        self.path = path
+        self.weights_computed = indices is None
+        if indices is None:
+            indices, weights = compute_weights(self.vertices, skeleton, weights_method)
+        self.bind(indices, weights)
+
+    # ------------------------------------------------------------------ binding
+    def bind(self, indices, weights):
+        """Replace the skin influences, (V, K) each."""
+        self.binding = SkinBinding(self.vertices, indices, weights, len(self.skeleton))
+
+    @property
+    def weights(self):
+        """(V, J) scipy.sparse CSR matrix of skin weights, rows sum to 1."""
+        return self.binding.matrix
+
+    @property
+    def num_bones(self):
+        return int(np.sum(self.skeleton.parents >= 0))
+
+    # ------------------------------------------------------------------ pipeline
+    def rest_pose(self):
+        """A new :class:`Pose` at the skeleton's rest."""
+        return Pose(self.skeleton)
+
+    def joint_matrices(self, pose):
+        """(J, 4, 4) model-space joint matrices of ``pose``."""
+        return local_to_model(self.skeleton, pose)
+
+    def skin(self, pose, out=None):
+        """(V, 3) skinned vertex positions of ``pose`` (a new float64 array unless ``out``)."""
+        palette = skinning_matrices(self.skeleton, self.joint_matrices(pose))
+        res = self.binding.skin(palette)
+        if out is None:
+            return res.astype(np.float64)
+        out[:] = res
+        return out
+
+    def bounds(self):
+        """(2, 3) min and max corner of the rest mesh."""
+        return np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)])
+
+    def height(self):
+        """Extent along the up axis, a scale for sizes in views and tolerances."""
+        lo, hi = self.bounds()
+        axis = 1 if self.up == "y" else 2
+        return float(hi[axis] - lo[axis]) or float(np.linalg.norm(hi - lo)) or 1.0
+
+    def __repr__(self):
+        return (f"Rig({self.name!r}: {len(self.vertices)} vertices, {len(self.faces)} faces, "
+                f"{len(self.skeleton)} joints, {len(self.clips)} clips)")
