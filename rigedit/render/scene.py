@@ -1,0 +1,168 @@
+"""The rig's actors in a pyvista plotter: skinned mesh, bones, floor, camera presets.
+
+Used by the interactive view and the off-screen recorder alike; never imports Qt. The mesh
+is added once and its points are updated in place each frame (DESIGN.md, pitfalls).
+"""
+from __future__ import annotations
+
+import numpy as np
+import pyvista as pv
+import vtk
+from vtk.util.numpy_support import numpy_to_vtk
+
+__all__ = ["RigScene", "up_vector", "front_vector", "faces_to_vtk"]
+
+MESH_COLOR = "#c9b79c"
+BONE_COLOR = "#2f6fd6"
+
+
+def up_vector(up):
+    """(3,) unit vector of the vertical axis ``"y"`` or ``"z"``."""
+    return np.array([0.0, 1.0, 0.0]) if up == "y" else np.array([0.0, 0.0, 1.0])
+
+
+def front_vector(up):
+    """(3,) direction from the character towards a camera that sees its front.
+
+    Y-up characters (glTF, the bundled ones) face +Z; Z-up ones (Blender exports such as the
+    elk project) face -Y.
+    """
+    return np.array([0.0, 0.0, 1.0]) if up == "y" else np.array([0.0, -1.0, 0.0])
+
+
+def faces_to_vtk(faces):
+    """(F, 3) triangles -> pyvista's flat ``[3, a, b, c, ...]`` cell array."""
+    faces = np.asarray(faces, dtype=np.int64)
+    return np.hstack([np.full((len(faces), 1), 3, dtype=np.int64), faces]).ravel()
+
+
+class RigScene:
+    """Actors showing one rig in a plotter.
+
+    Parameters
+    ----------
+    plotter : pyvista.Plotter or pyvistaqt.QtInteractor
+    rig : Rig
+    show_skeleton : bool
+    show_floor : bool
+
+    Attributes
+    ----------
+    mesh : pyvista.PolyData
+        The skinned surface; its points are the current pose (updated in place).
+    bones : pyvista.PolyData
+        One line per bone; points are the joint positions.
+    """
+
+    def __init__(self, plotter, rig, show_skeleton=True, show_floor=True):
+        self.plotter = plotter
+        self.rig = rig
+        self.up = up_vector(rig.up)
+        self.front = front_vector(rig.up)
+        self.mesh = pv.PolyData(rig.vertices.astype(np.float32).copy(), faces_to_vtk(rig.faces))
+        # Normals recomputed by VTK inside the pipeline each time the points change: smooth
+        # shading stays right under deformation at a few ms per frame.
+        self._normals = vtk.vtkPolyDataNormals()
+        self._normals.SetInputData(self.mesh)
+        self._normals.SplittingOff()
+        self._normals.ConsistencyOff()
+        self._normals.AutoOrientNormalsOff()
+        self._normals.ComputeCellNormalsOff()
+        self.mesh_actor = plotter.add_mesh(self._normals, color=MESH_COLOR, smooth_shading=True,
+                                           specular=0.25, specular_power=20, name="rig-mesh")
+        sk = rig.skeleton
+        child = np.flatnonzero(sk.parents >= 0)
+        lines = np.column_stack([np.full(len(child), 2), sk.parents[child], child]).ravel()
+        self.bones = pv.PolyData(sk.bind_matrices[:, :3, 3].copy())
+        if len(child):
+            self.bones.lines = lines
+        self.bone_actor = plotter.add_mesh(self.bones, color=BONE_COLOR, line_width=3,
+                                           render_lines_as_tubes=False, name="rig-bones",
+                                           reset_camera=False)
+        self.bone_actor.SetVisibility(show_skeleton)
+        self.floor_actor = self._add_floor() if show_floor else None
+        self.joint_positions = sk.bind_matrices[:, :3, 3].copy()
+        self.view("front")
+
+    # ------------------------------------------------------------------ actors
+    def _add_floor(self):
+        lo, hi = self.rig.bounds()
+        size = 2.5 * float(np.max(hi - lo))
+        center = 0.5 * (lo + hi)
+        ground = center.copy()
+        axis = 1 if self.rig.up == "y" else 2
+        ground[axis] = min(0.0, lo[axis]) if lo[axis] > -0.05 * size else lo[axis]
+        plane = pv.Plane(center=ground, direction=self.up, i_size=size, j_size=size,
+                         i_resolution=20, j_resolution=20)
+        self.plotter.add_mesh(plane, color="#9aa3ad", opacity=0.35, name="rig-floor",
+                              reset_camera=False, pickable=False)
+        return self.plotter.add_mesh(plane.extract_all_edges(), color="#6b7580", opacity=0.5,
+                                     name="rig-floor-grid", reset_camera=False, pickable=False)
+
+    def set_skeleton_visible(self, visible):
+        self.bone_actor.SetVisibility(bool(visible))
+
+    # ------------------------------------------------------------------ per frame
+    def update(self, pose):
+        """Skin ``pose`` and write it into the existing actors (no re-add, no render).
+
+        Returns
+        -------
+        model_matrices : (J, 4, 4) float64
+        """
+        model = self.rig.joint_matrices(pose)
+        self.update_from_matrices(model)
+        return model
+
+    def update_from_matrices(self, model):
+        """Same as :meth:`update` from model matrices already computed."""
+        palette = np.matmul(model, self.rig.skeleton.inverse_bind_matrices)
+        verts = self.rig.binding.skin(palette)
+        pts = self.mesh.points
+        pts[:] = verts
+        self.mesh.GetPoints().Modified()
+        self.mesh.Modified()
+        self.joint_positions = model[:, :3, 3].copy()
+        self.bones.points[:] = self.joint_positions
+        self.bones.GetPoints().Modified()
+        self.bones.Modified()
+
+    # ------------------------------------------------------------------ camera
+    def view(self, name="front", angle=0.0, distance=2.2, target=None):
+        """Point the camera at the character.
+
+        Parameters
+        ----------
+        name : {"front", "side", "top", "back"}
+        angle : float
+            Degrees turned about the vertical axis (counter-clockwise seen from above).
+        distance : float
+            In units of the character's largest extent.
+        target : (3,) float, optional
+            Point looked at; the rest mesh's centre when omitted.
+        """
+        lo, hi = self.rig.bounds()
+        center = 0.5 * (lo + hi) if target is None else np.asarray(target, dtype=float)
+        extent = float(np.max(hi - lo)) or 1.0
+        side = np.cross(self.up, self.front)  # the character's left, seen from the front
+        direction = {"front": self.front, "back": -self.front, "side": -side,
+                     "top": self.up}[name]
+        if name != "top":
+            a = np.radians(angle)
+            # Rodrigues about the up axis (direction is perpendicular to it here).
+            direction = (direction * np.cos(a) + np.cross(self.up, direction) * np.sin(a))
+            direction = direction + 0.15 * self.up  # a little from above, as a person sees it
+        direction = direction / np.linalg.norm(direction)
+        cam = self.plotter.camera
+        cam.focal_point = center
+        cam.position = center + direction * distance * extent
+        cam.up = self.front * -1 if name == "top" else self.up
+        self.plotter.reset_camera_clipping_range()
+        self._view = (name, angle, distance)
+
+    def follow(self, offset):
+        """Shift the camera by ``offset`` (3,) model units, to track root motion."""
+        cam = self.plotter.camera
+        cam.focal_point = np.asarray(cam.focal_point) + offset
+        cam.position = np.asarray(cam.position) + offset
+        self.plotter.reset_camera_clipping_range()
