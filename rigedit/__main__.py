@@ -1,0 +1,6 @@
+"""``python -m rigedit`` runs the ``rigedit`` command."""
+import sys
+
+from .cli import main
+
+sys.exit(main())

@@ -1,0 +1,179 @@
+"""The ``rigedit`` command: headless jobs on rigs (info, list, weights, render).
+
+Bad input (a missing or malformed file, an unknown clip or joint) prints one line naming the
+file and the problem and exits with status 2; no traceback.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+import warnings
+from pathlib import Path
+
+__all__ = ["main", "build_parser"]
+
+EXIT_BAD_INPUT = 2
+
+
+class UsageError(Exception):
+    """Bad input that is not about a file (an unknown clip, a bad option value)."""
+
+
+def _load(rig_arg, method="idw"):
+    import rigedit
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rig = rigedit.load_rig(rig_arg, weights_method=method)
+    for w in caught:  # computed weights, skipped joints: worth a line, not a traceback
+        print(f"rigedit: warning: {w.message}", file=sys.stderr)
+    return rig
+
+
+def cmd_info(args):
+    rig = _load(args.rig)
+    sk = rig.skeleton
+    lo, hi = rig.bounds()
+    rows = [("name", rig.name), ("path", rig.path), ("vertices", len(rig.vertices)),
+            ("faces", len(rig.faces)), ("joints", len(sk)), ("bones", rig.num_bones),
+            ("max_influences", rig.binding.indices.shape[1]),
+            ("weights", "computed (idw)" if rig.weights_computed else "from file"),
+            ("up", rig.up), ("bounds_min", " ".join(f"{v:.4g}" for v in lo)),
+            ("bounds_max", " ".join(f"{v:.4g}" for v in hi)),
+            ("clips", " ".join(sorted(rig.clips)) or "-")]
+    for key, value in rows:
+        print(f"{key}: {value}")
+    return 0
+
+
+def cmd_list(args):
+    rig = _load(args.rig)
+    for name in sorted(rig.clips):
+        clip = rig.clips[name]
+        print(f"{name}\t{clip.duration:.3f}s\t{'loop' if clip.loop else 'once'}")
+    return 0
+
+
+def cmd_weights(args):
+    from .io.weights_npz import save_weights
+    from .model.weights import compute_weights
+
+    if not str(args.output).endswith(".npz"):
+        raise UsageError(f"{args.output}: expected an output file name ending in .npz")
+    rig = _load(args.rig)
+    t0 = time.perf_counter()
+    idx, w = compute_weights(rig.vertices, rig.skeleton, args.method, args.max_influences)
+    dt = time.perf_counter() - t0
+    save_weights(args.output, idx, w, rig.skeleton.names)
+    print(f"wrote {args.output}: {len(idx)} vertices, {idx.shape[1]} influences, "
+          f"method {args.method}, {dt:.3f} s")
+    return 0
+
+
+def _parse_size(text):
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise UsageError(f"--size: expected WIDTHxHEIGHT such as 1280x720, got {text!r}") from None
+    return w, h
+
+
+def cmd_render(args):
+    from .render.recorder import record_clip
+
+    size = _parse_size(args.size)
+    if args.fps <= 0:
+        raise UsageError(f"--fps: expected a positive number, got {args.fps}")
+    if args.duration is not None and args.duration <= 0:
+        raise UsageError(f"--duration: expected a positive number, got {args.duration}")
+    rig = _load(args.rig)
+    if args.clip not in rig.clips:
+        raise UsageError(f"{rig.path}: unknown clip {args.clip!r}; clips: "
+                         f"{', '.join(sorted(rig.clips)) or 'none'}")
+    clip = rig.clips[args.clip]
+    bar = None
+    if sys.stderr.isatty() and not args.quiet:
+        from tqdm import tqdm
+
+        bar = tqdm(total=None, unit="frame", desc=f"render {args.clip}")
+
+    def progress(done, total):
+        if bar is not None:
+            bar.total = total
+            bar.update(done - bar.n)
+        return True
+
+    t0 = time.perf_counter()
+    try:
+        n = record_clip(rig, clip, args.output, fps=args.fps, duration=args.duration,
+                        size=size, angle=args.angle, view=args.view,
+                        show_skeleton=args.skeleton, progress=progress)
+    finally:
+        if bar is not None:
+            bar.close()
+    dt = time.perf_counter() - t0
+    print(f"wrote {Path(args.output).resolve()}: {n} frames at {args.fps:g} fps, "
+          f"{size[0]}x{size[1]}, {dt:.1f} s ({n / dt:.1f} frames/s)")
+    return 0
+
+
+def build_parser():
+    p = argparse.ArgumentParser(prog="rigedit", description="Rig editor for 3D characters: "
+                                "headless jobs. RIG is a rig folder or a bundled name "
+                                "(quadruped, the default, or humanoid).")
+    sub = p.add_subparsers(dest="command", required=True)
+    s = sub.add_parser("info", help="print facts about a rig as key: value lines")
+    s.add_argument("rig", nargs="?")
+    s.set_defaults(func=cmd_info)
+    s = sub.add_parser("list", help="list a rig's clips and durations")
+    s.add_argument("rig", nargs="?")
+    s.set_defaults(func=cmd_list)
+    s = sub.add_parser("weights", help="compute skinning weights into a .npz file")
+    s.add_argument("rig", nargs="?")
+    s.add_argument("--method", default="idw", help="weights method (default idw)")
+    s.add_argument("--max-influences", type=int, default=4, metavar="K")
+    s.add_argument("-o", "--output", required=True, metavar="FILE.npz")
+    s.set_defaults(func=cmd_weights)
+    s = sub.add_parser("render", help="render a clip off-screen to MP4 or GIF")
+    s.add_argument("clip")
+    s.add_argument("--rig")
+    s.add_argument("-o", "--output", required=True, metavar="OUT.mp4|OUT.gif")
+    s.add_argument("--fps", type=float, default=30.0)
+    s.add_argument("--duration", type=float, default=None, metavar="S",
+                   help="seconds to render (default: the clip's duration)")
+    s.add_argument("--angle", type=float, default=0.0, metavar="DEG",
+                   help="turn the front camera about the vertical axis")
+    s.add_argument("--view", choices=("front", "side", "back", "top"), default="front")
+    s.add_argument("--size", default="1280x720", metavar="WxH")
+    s.add_argument("--skeleton", action="store_true", help="draw the bones too")
+    s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    s.set_defaults(func=cmd_render)
+    return p
+
+
+def main(argv=None):
+    """Entry point; returns the exit status."""
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    from .errors import RigFileError
+
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except (RigFileError, UsageError) as exc:
+        print(f"rigedit: error: {exc}", file=sys.stderr)
+    except KeyError as exc:  # unknown joint
+        print(f"rigedit: error: {exc.args[0] if exc.args else exc}", file=sys.stderr)
+    except ValueError as exc:
+        print(f"rigedit: error: {exc}", file=sys.stderr)
+    except OSError as exc:
+        name = getattr(exc, "filename", None)
+        print(f"rigedit: error: {name + ': ' if name else ''}{exc.strerror or exc}",
+              file=sys.stderr)
+    return EXIT_BAD_INPUT
+
+
+if __name__ == "__main__":
+    sys.exit(main())
