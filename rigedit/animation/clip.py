@@ -4,13 +4,15 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.pose import Pose
-from .interpolate import MODES, ROTATION_MODES, VECTOR_MODES, sample_track
+from .interpolate import MODES, ROTATION_MODES, VECTOR_MODES, catmull_rom_tangents, sample_track
 
 __all__ = ["CHANNELS", "Track", "Clip"]
 
 #: Channel name -> value width.
 CHANNELS = {"translation": 3, "rotation": 4, "scale": 3}
 DEFAULT_MODE = {"translation": "linear", "rotation": "slerp", "scale": "linear"}
+#: Two key times closer than this (seconds) are the same key.
+KEY_TOLERANCE = 1e-6
 
 
 class Track:
@@ -24,17 +26,19 @@ class Track:
     values : (K, C) float
         Local values: translations and scales (C = 3) or quaternions x, y, z, w (C = 4).
     interpolation : str
-        ``step`` or ``linear`` for vectors; ``step``, ``nlerp`` or ``slerp`` for rotations
-        (``linear`` on a rotation means ``nlerp``).
+        ``step``, ``linear`` or ``catmull_rom`` for vectors; ``step``, ``nlerp``, ``slerp``,
+        ``hybrid`` or ``catmull_rom`` for rotations (``linear`` on a rotation is read as
+        ``nlerp``). See :mod:`rigedit.animation.interpolate`.
 
     Notes
     -----
     Keys are validated once here: sorted by time, quaternions normalised and each flipped to
     its predecessor's hemisphere so that every interpolation takes the shortest path without a
-    per-frame test.
+    per-frame test. Tracks are treated as immutable: edits return new tracks, so an undo
+    snapshot of a clip is a shallow copy of its track dictionary.
     """
 
-    __slots__ = ("channel", "times", "values", "interpolation")
+    __slots__ = ("channel", "times", "values", "interpolation", "tangents")
 
     def __init__(self, channel, times, values, interpolation=None):
         if channel not in CHANNELS:
@@ -64,10 +68,14 @@ class Track:
                 if np.dot(values[i - 1], values[i]) < 0:
                     values[i] = -values[i]
         mode = interpolation or DEFAULT_MODE[channel]
-        allowed = ROTATION_MODES + ("linear",) if channel == "rotation" else VECTOR_MODES
+        if channel == "rotation" and mode == "linear":
+            mode = "nlerp"
+        allowed = ROTATION_MODES if channel == "rotation" else VECTOR_MODES
         if mode not in allowed:
             raise ValueError(f"{channel} track: expected interpolation in {allowed}, got {mode!r}")
         self.times, self.values, self.interpolation = times, values, mode
+        # baked once: per-frame sampling of a spline is then one cubic
+        self.tangents = catmull_rom_tangents(times, values) if mode == "catmull_rom" else None
 
     def __len__(self):
         return len(self.times)
@@ -75,14 +83,54 @@ class Track:
     def sample(self, t):
         """(C,) value at time ``t`` (clamped to the first and last key)."""
         return sample_track(self.times, self.values, t, self.interpolation,
-                            self.channel == "rotation")
+                            self.channel == "rotation", self.tangents)
+
+    def key_index(self, t, tol=KEY_TOLERANCE):
+        """Index of the key within ``tol`` seconds of ``t``, or None."""
+        if len(self.times) == 0:
+            return None
+        i = int(np.argmin(np.abs(self.times - t)))
+        return i if abs(self.times[i] - t) <= tol else None
 
     def with_key(self, t, value):
         """A new track with a key set at ``t`` (replacing one at the same time)."""
-        keep = np.abs(self.times - t) > 1e-9
+        keep = np.abs(self.times - t) > KEY_TOLERANCE
         return Track(self.channel, np.r_[self.times[keep], t],
                      np.vstack([self.values[keep], np.asarray(value, dtype=float)]),
                      self.interpolation)
+
+    def without_keys(self, times, tol=KEY_TOLERANCE):
+        """A new track without the keys at ``times``; None when no key would remain."""
+        times = np.atleast_1d(np.asarray(times, dtype=float))
+        keep = np.all(np.abs(self.times[:, None] - times[None, :]) > tol, axis=1)
+        if not keep.any():
+            return None
+        return Track(self.channel, self.times[keep], self.values[keep], self.interpolation)
+
+    def with_moved_keys(self, mapping, tol=KEY_TOLERANCE):
+        """A new track with keys moved: ``mapping`` is ``{old time: new time}``.
+
+        A moved key replaces a key already at its new time (one that is not moving itself).
+        """
+        new_t, new_v = [], []
+        moved = set()
+        for old, new in mapping.items():
+            i = self.key_index(old, tol)
+            if i is not None:
+                moved.add(i)
+                new_t.append(float(new))
+                new_v.append(self.values[i])
+        if not moved:
+            return self
+        rest = [i for i in range(len(self.times)) if i not in moved
+                and np.all(np.abs(self.times[i] - np.asarray(new_t)) > tol)]
+        times = np.r_[self.times[rest], new_t]
+        values = np.vstack([self.values[rest].reshape(-1, self.values.shape[1]), new_v])
+        return Track(self.channel, times, values, self.interpolation)
+
+    def with_interpolation(self, mode):
+        """The same keys with another interpolation mode."""
+        return Track(self.channel, self.times, self.values, mode)
 
     def copy(self):
         return Track(self.channel, self.times.copy(), self.values.copy(), self.interpolation)
@@ -124,6 +172,130 @@ class Clip:
                              f"got {track.channel!r}")
         self.tracks[(joint, channel)] = track
         self.revision = getattr(self, "revision", 0) + 1
+
+    def remove_track(self, joint, channel):
+        if self.tracks.pop((joint, channel), None) is not None:
+            self._touch()
+
+    # ------------------------------------------------------------------ editing
+    # Each edit replaces whole Track objects (never mutates one), so ``state()`` is cheap and
+    # an undo command stores two states.
+    def _touch(self):
+        self.revision += 1
+
+    def state(self):
+        """A snapshot for undo: restore it with :meth:`restore`."""
+        return (dict(self.tracks), self.duration, self.loop, self.name)
+
+    def restore(self, state):
+        tracks, self.duration, self.loop, self.name = state
+        self.tracks = dict(tracks)
+        self._touch()
+
+    def set_key(self, joint, channel, t, value):
+        """Key one channel of one joint at ``t`` (creating the track)."""
+        track = self.tracks.get((joint, channel))
+        if track is None:
+            self.set_track(joint, channel, Track(channel, [t], [value]))
+        else:
+            self.set_track(joint, channel, track.with_key(t, value))
+
+    def key_pose(self, pose, t, joints=None):
+        """Key ``joints`` (names; all when None) of ``pose`` at time ``t``.
+
+        Rotation is always keyed; translation and scale only where the joint already has that
+        track or the pose moves it away from rest, so keying a rotation-only rig does not add
+        tracks that hold the rest value.
+
+        Returns
+        -------
+        count : int
+            Channels keyed.
+        """
+        sk = self.skeleton
+        names = sk.names if joints is None else list(joints)
+        count = 0
+        for name in names:
+            j = sk.joint_index(name)
+            for channel in ("translation", "rotation", "scale"):
+                value = getattr(pose, channel)[j]
+                rest = getattr(sk, f"rest_{channel}")[j]
+                if (channel == "rotation" or (name, channel) in self.tracks
+                        or not np.allclose(value, rest, atol=1e-9)):
+                    self.set_key(name, channel, t, value)
+                    count += 1
+        return count
+
+    def _selected(self, joints):
+        wanted = None if joints is None else set(joints)
+        return [k for k in self.tracks if wanted is None or k[0] in wanted]
+
+    def delete_keys(self, times, joints=None):
+        """Delete the keys at ``times`` (seconds) of ``joints`` (all when None); a track that
+        loses its last key is removed. Returns the number of keys deleted."""
+        times = np.atleast_1d(np.asarray(times, dtype=float))
+        deleted = 0
+        for key in self._selected(joints):
+            track = self.tracks[key]
+            new = track.without_keys(times)
+            n = len(track) - (0 if new is None else len(new))
+            if n:
+                deleted += n
+                if new is None:
+                    del self.tracks[key]
+                else:
+                    self.tracks[key] = new
+        if deleted:
+            self._touch()
+        return deleted
+
+    def move_keys(self, mapping, joints=None):
+        """Move keys in time: ``mapping`` is ``{old time: new time}`` (negative times are
+        rejected). Returns the number of tracks changed."""
+        for new in mapping.values():
+            if not np.isfinite(new) or new < 0:
+                raise ValueError(f"clip {self.name!r}: expected key times >= 0, got {new}")
+        changed = 0
+        for key in self._selected(joints):
+            track = self.tracks[key]
+            new = track.with_moved_keys(mapping)
+            if new is not track:
+                self.tracks[key] = new
+                changed += 1
+        if changed:
+            self._touch()
+        return changed
+
+    def copy_keys(self, t, joints=None):
+        """The values of ``joints``' tracks at time ``t``: ``{(joint, channel): value}``, for
+        :meth:`paste_keys` (a time between keys copies the interpolated value)."""
+        t = self.local_time(t)
+        return {k: self.tracks[k].sample(t) for k in self._selected(joints)}
+
+    def paste_keys(self, data, t):
+        """Key every ``(joint, channel): value`` of ``data`` at ``t``."""
+        for (joint, channel), value in data.items():
+            self.set_key(joint, channel, t, value)
+        return len(data)
+
+    def set_interpolation(self, mode, joint=None, channel=None):
+        """Set the interpolation of one track, or of every track matching ``joint`` and/or
+        ``channel`` (None matches all). ``ValueError`` when a track does not support ``mode``
+        (nothing is changed then). Returns the number of tracks set."""
+        keys = [k for k in self.tracks if (joint is None or k[0] == joint)
+                and (channel is None or k[1] == channel)]
+        new = {k: self.tracks[k].with_interpolation(mode) for k in keys}
+        self.tracks.update(new)
+        if new:
+            self._touch()
+        return len(new)
+
+    def set_duration(self, duration):
+        duration = float(duration)
+        if not np.isfinite(duration) or duration <= 0:
+            raise ValueError(f"clip {self.name!r}: expected a duration > 0, got {duration}")
+        self.duration = duration
+        self._touch()
 
     def key_times(self, joint=None):
         """Sorted unique key times of one joint, or of all joints."""
