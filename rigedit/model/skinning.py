@@ -5,9 +5,9 @@ import numpy as np
 import scipy.sparse as sp
 
 try:  # The in-place kernel behind ``csr_matrix @ dense``; lets a frame reuse its buffers.
-    from scipy.sparse._sparsetools import csc_matvecs as _csc_matvecs
+    from scipy.sparse._sparsetools import csr_matvecs as _csr_matvecs
 except ImportError:  # pragma: no cover - SciPy moved it; fall back to the public product
-    _csc_matvecs = None
+    _csr_matvecs = None
 
 __all__ = ["SkinBinding", "linear_blend_skin", "top_k_influences", "dense_weights"]
 
@@ -100,10 +100,10 @@ class SkinBinding:
                            (rows, self.indices.ravel())), shape=(v, self.num_joints))
         w.sum_duplicates()
         w.eliminate_zeros()
+        w.sort_indices()
+        # Row-major: one pass over the output. A CSC product makes one pass per joint, which
+        # measured 6x slower at 1M vertices once the (V, 12) output no longer fits in cache.
         self.matrix = w
-        # Column-major storage: measured 1.9 ms against 3.3 ms for CSR at 100k vertices, as
-        # each joint's column streams its palette row into the vertices it moves.
-        self._csc = w.tocsc()
         self._rest32 = rest.astype(np.float32)
         self._palette = np.empty((self.num_joints, 12), dtype=np.float32)
         self._blend = np.empty((v, 12), dtype=np.float32)
@@ -135,10 +135,10 @@ class SkinBinding:
         """
         self._palette[:] = np.asarray(palette)[:, :3, :].reshape(-1, 12)
         blend = self._blend
-        w = self._csc
-        if _csc_matvecs is not None:
+        w = self.matrix
+        if _csr_matvecs is not None:
             blend.fill(0.0)
-            _csc_matvecs(w.shape[0], w.shape[1], 12, w.indptr, w.indices, w.data,
+            _csr_matvecs(w.shape[0], w.shape[1], 12, w.indptr, w.indices, w.data,
                          self._palette.ravel(), blend.ravel())
         else:
             blend[:] = w @ self._palette
