@@ -32,7 +32,8 @@ def test_ply_and_stl_through_meshio(tmp_path):
 
     v, f = cylinder(rings=3, segments=5)
     for ext in ("ply", "stl", "vtk"):
-        meshio.write_points_cells(tmp_path / f"m.{ext}", v, [("triangle", f)])
+        # Binary files: meshio's ASCII-STL sniffing overflows on its own ASCII output.
+        meshio.write_points_cells(tmp_path / f"m.{ext}", v, [("triangle", f)], binary=True)
         v2, f2 = load_mesh(tmp_path / f"m.{ext}")
         assert len(f2) == len(f)
         assert np.allclose(np.sort(v2, axis=0), np.sort(v, axis=0), atol=1e-5)
