@@ -1,10 +1,16 @@
 """Off-screen recording of a clip to MP4 (H.264, yuv420p) or GIF.
 
-The recorder builds its own off-screen plotter and :class:`RigScene`, so it shares no mutable
-state with an interactive view; frame ``i`` shows the clip at exactly ``t = start + i / fps``.
+The recorder builds its own off-screen plotter and :class:`RigScene` and samples a private copy
+of the clip, so it shares no mutable state with an interactive view; frame ``i`` shows the
+clip at exactly ``t = start + i / fps``. The file is written under a temporary name beside the
+target and renamed over it at the end, so a cancelled or failed recording leaves any existing
+file untouched.
 """
 from __future__ import annotations
 
+import contextlib
+import os
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +19,8 @@ import pyvista as pv
 from ..errors import RigFileError
 from .scene import RigScene
 
-__all__ = ["record_clip", "frame_times", "VIDEO_SUFFIXES", "RecordingCancelled"]
+__all__ = ["record_clip", "frame_times", "camera_state", "apply_camera", "VIDEO_SUFFIXES",
+           "RecordingCancelled"]
 
 VIDEO_SUFFIXES = (".mp4", ".gif")
 
@@ -33,46 +40,69 @@ def frame_times(duration, fps, start=0.0):
 
 
 class _Writer:
-    def __init__(self, path, fps, quality):
+    """Streams frames to ffmpeg (MP4) or collects palette frames (GIF) into a temporary file;
+    :meth:`commit` renames it over the target."""
+
+    def __init__(self, path, fps, quality, preset="veryfast"):
         import imageio.v2 as imageio
 
         self.path = Path(path)
+        self.fps = fps
         self.gif = self.path.suffix.lower() == ".gif"
+        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.stem}.", suffix=self.path.suffix,
+                                   dir=self.path.parent)
+        os.close(fd)
+        self.tmp = Path(tmp)
         self.frames = []
         if not self.gif:
+            # ffmpeg encodes in its own process while the next frame renders here
             self.writer = imageio.get_writer(
-                str(self.path), format="FFMPEG", mode="I", fps=fps, codec="libx264",
+                str(self.tmp), format="FFMPEG", mode="I", fps=fps, codec="libx264",
                 pixelformat="yuv420p", quality=quality, macro_block_size=2,
-                output_params=["-preset", "veryfast"])
+                output_params=["-preset", preset], ffmpeg_log_level="error")
 
     def append(self, frame):
         if self.gif:
-            self.frames.append(frame)
+            from PIL import Image
+
+            # one byte per pixel instead of three: a long GIF stays in memory until the end
+            self.frames.append(Image.fromarray(frame[..., :3]).quantize(
+                256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE))
         else:
             self.writer.append_data(frame)
 
-    def close(self, fps):
+    def commit(self):
         if self.gif:
-            import imageio.v3 as iio
-
-            iio.imwrite(self.path, np.stack(self.frames), extension=".gif",
-                        duration=1000.0 / fps, loop=0)
+            first, rest = self.frames[0], self.frames[1:]
+            first.save(self.tmp, format="GIF", save_all=True, append_images=rest,
+                       duration=int(round(1000.0 / self.fps)), loop=0, optimize=False)
+            self.frames = []
         else:
             self.writer.close()
+        os.replace(self.tmp, self.path)
+
+    def abort(self):
+        with contextlib.suppress(Exception):
+            if not self.gif:
+                self.writer.close()
+        self.frames = []
+        with contextlib.suppress(OSError):
+            self.tmp.unlink()
 
 
 def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=0.0,
                 view="front", angle=0.0, camera=None, orbit=0.0, follow_root=True,
-                show_skeleton=False, multi_samples=0, quality=7, progress=None):
+                show_skeleton=False, multi_samples=0, quality=7, progress=None,
+                show_floor=True, preset="veryfast"):
     """Render ``clip`` on ``rig`` off-screen into a video file.
 
     Parameters
     ----------
     rig : Rig
     clip : Clip or None
-        None records the rest pose.
+        None records the rest pose. A copy is sampled, so the caller may keep editing.
     path : str or Path
-        ``.mp4`` (H.264, yuv420p) or ``.gif``.
+        ``.mp4`` (H.264, yuv420p) or ``.gif``. Written atomically.
     fps : float
     duration : float, optional
         Seconds to record; the clip's duration when omitted.
@@ -83,16 +113,20 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
     view, angle :
         Camera preset and turn about the vertical axis in degrees (see ``RigScene.view``).
     camera : dict, optional
-        ``{"position", "focal_point", "up", "view_angle"}`` to copy (the editor's current view);
+        ``{"position", "focal_point", "up"}`` and optionally ``"view_angle"``,
+        ``"parallel_projection"``, ``"parallel_scale"`` to copy (the editor's current view);
         overrides ``view``/``angle``.
     orbit : float
         Degrees the camera turns about the vertical axis over the recording.
     follow_root : bool
         Move the camera with the root joint's horizontal motion (walks stay in frame).
+    show_skeleton, show_floor : bool
     multi_samples : int
         Anti-aliasing samples (0 is several times faster in software OpenGL).
     quality : int
         imageio-ffmpeg quality 0-10 for MP4.
+    preset : str
+        x264 preset; ``veryfast`` keeps the encoder from being the bottleneck.
     progress : callable(done, total) -> bool, optional
         Called after each frame; returning False cancels (raises ``RecordingCancelled``).
 
@@ -100,6 +134,15 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
     -------
     frames : int
         Frames written.
+
+    Raises
+    ------
+    RigFileError
+        Bad suffix or missing folder.
+    ValueError
+        Bad size or frame rate.
+    RecordingCancelled
+        When ``progress`` returned False; no file is left behind (an existing one is kept).
     """
     path = Path(path)
     if path.suffix.lower() not in VIDEO_SUFFIXES:
@@ -113,8 +156,10 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
     if duration is None:
         duration = clip.duration if clip is not None and clip.duration > 0 else 1.0
     times = frame_times(duration, fps, start)
-    if not path.parent.exists():
+    if not path.parent.is_dir():
         raise RigFileError(path, "the folder does not exist")
+    if clip is not None:
+        clip = clip.copy()   # the editor may change its clip while we render
 
     plotter = pv.Plotter(off_screen=True, window_size=(width, height))
     writer = None
@@ -122,23 +167,20 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         plotter.enable_anti_aliasing("msaa", multi_samples=multi_samples) if multi_samples \
             else plotter.disable_anti_aliasing()
         plotter.set_background("#eef1f4", top="#c5ccd6")
-        scene = RigScene(plotter, rig, show_skeleton=show_skeleton)
+        scene = RigScene(plotter, rig, show_skeleton=show_skeleton, show_floor=show_floor)
         pose = rig.rest_pose()
         if clip is not None:
             clip.sample(times[0], out=pose)
         model0 = scene.update(pose)
         if camera is not None:
-            cam = plotter.camera
-            cam.position, cam.focal_point = camera["position"], camera["focal_point"]
-            cam.up = camera["up"]
-            if "view_angle" in camera:
-                cam.view_angle = camera["view_angle"]
+            apply_camera(plotter.camera, camera)
         else:
             scene.view(view, angle)
         base_pos = np.array(plotter.camera.position)
         base_focal = np.array(plotter.camera.focal_point)
         root0 = model0[0, :3, 3].copy()
-        writer = _Writer(path, fps, quality)
+        up = scene.up
+        writer = _Writer(path, fps, quality, preset)
         for i, t in enumerate(times):
             if clip is not None:
                 clip.sample(t, out=pose)
@@ -146,11 +188,10 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
             shift = np.zeros(3)
             if follow_root:
                 shift = model[0, :3, 3] - root0
-                shift -= np.dot(shift, scene.up) * scene.up  # horizontal part only
+                shift -= np.dot(shift, up) * up  # horizontal part only
             rel = base_pos - base_focal
             if orbit:
                 a = np.radians(orbit * i / max(len(times), 1))
-                up = scene.up
                 rel = (rel * np.cos(a) + np.cross(up, rel) * np.sin(a)
                        + up * np.dot(up, rel) * (1 - np.cos(a)))
             plotter.camera.focal_point = base_focal + shift
@@ -160,16 +201,29 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
             writer.append(plotter.screenshot(return_img=True))
             if progress is not None and progress(i + 1, len(times)) is False:
                 raise RecordingCancelled(f"recording cancelled after {i + 1} frames")
-        writer.close(fps)
+        writer.commit()
         writer = None
         return len(times)
-    except BaseException:
-        if writer is not None:
-            try:
-                writer.close(fps)
-            except Exception:
-                pass
-            path.unlink(missing_ok=True)
-        raise
     finally:
+        if writer is not None:
+            writer.abort()
         plotter.close()
+
+
+def camera_state(camera):
+    """The parts of a VTK/pyvista camera that :func:`record_clip` copies, as plain data."""
+    return {"position": tuple(camera.position), "focal_point": tuple(camera.focal_point),
+            "up": tuple(camera.up), "view_angle": float(camera.view_angle),
+            "parallel_projection": bool(camera.parallel_projection),
+            "parallel_scale": float(camera.parallel_scale)}
+
+
+def apply_camera(camera, state):
+    """Set a pyvista camera from :func:`camera_state`'s dictionary."""
+    camera.position, camera.focal_point = state["position"], state["focal_point"]
+    camera.up = state["up"]
+    if "view_angle" in state:
+        camera.view_angle = state["view_angle"]
+    if state.get("parallel_projection"):
+        camera.parallel_projection = True
+        camera.parallel_scale = state.get("parallel_scale", camera.parallel_scale)

@@ -1,0 +1,76 @@
+"""The off-screen recorder: frame count and size read back with imageio, moving frames, GIF,
+cancel leaves no file, the camera of a view is copied."""
+import imageio.v3 as iio
+import numpy as np
+import pytest
+
+from builders import cylinder_rig
+from rigedit.errors import RigFileError
+from rigedit.render.recorder import RecordingCancelled, frame_times, record_clip
+
+SIZE = (160, 120)
+
+
+@pytest.fixture(scope="module")
+def rig():
+    return cylinder_rig()
+
+
+def read_frames(path):
+    return np.stack(list(iio.imiter(path)))
+
+
+def test_frame_times_are_exact_multiples_of_the_step():
+    t = frame_times(1.0, 30)
+    assert len(t) == 30 and t[0] == 0.0 and t[7] == 7 / 30
+    assert len(frame_times(0.5, 24, start=1.0)) == 12
+
+
+def test_mp4_has_the_requested_frames_and_size_and_they_move(rig, tmp_path):
+    path = tmp_path / "bend.mp4"
+    seen = []
+    n = record_clip(rig, rig.clips["bend"], path, fps=10, duration=1.0, size=SIZE,
+                    progress=lambda done, total: seen.append((done, total)))
+    assert n == 10 and seen[-1] == (10, 10) and len(seen) == 10
+    frames = read_frames(path)
+    assert frames.shape == (10, SIZE[1], SIZE[0], 3)
+    # the cylinder bends 60 degrees at t = 0.5: that frame differs from the first one
+    diff = np.abs(frames[5].astype(int) - frames[0].astype(int)).mean()
+    assert diff > 1.0
+    assert [p.name for p in tmp_path.iterdir()] == ["bend.mp4"]
+
+
+def test_gif_with_orbit(rig, tmp_path):
+    path = tmp_path / "turn.gif"
+    assert record_clip(rig, None, path, fps=8, duration=0.5, size=SIZE, orbit=90) == 4
+    frames = read_frames(path)
+    assert frames.shape[:3] == (4, SIZE[1], SIZE[0])
+    assert np.abs(frames[3].astype(int) - frames[0].astype(int)).mean() > 1.0
+
+
+def test_cancel_keeps_an_existing_file_and_leaves_no_temporary(rig, tmp_path):
+    path = tmp_path / "out.mp4"
+    path.write_bytes(b"old video")
+    with pytest.raises(RecordingCancelled):
+        record_clip(rig, rig.clips["bend"], path, fps=10, duration=1.0, size=SIZE,
+                    progress=lambda done, total: done < 3)
+    assert path.read_bytes() == b"old video"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.mp4"]
+
+
+def test_camera_dict_is_used(rig, tmp_path):
+    a, b = tmp_path / "a.gif", tmp_path / "b.gif"
+    record_clip(rig, None, a, fps=4, duration=0.25, size=SIZE)
+    record_clip(rig, None, b, fps=4, duration=0.25, size=SIZE,
+                camera={"position": (6, 1.5, 0), "focal_point": (0, 1.5, 0), "up": (0, 1, 0)})
+    fa, fb = read_frames(a)[0], read_frames(b)[0]
+    assert np.abs(fa.astype(int) - fb.astype(int)).mean() > 1.0
+
+
+def test_rejects_bad_arguments(rig, tmp_path):
+    with pytest.raises(RigFileError, match="ending in"):
+        record_clip(rig, None, tmp_path / "x.avi")
+    with pytest.raises(ValueError, match="even"):
+        record_clip(rig, None, tmp_path / "x.mp4", size=(161, 120))
+    with pytest.raises(RigFileError, match="folder"):
+        record_clip(rig, None, tmp_path / "missing" / "x.mp4", size=SIZE)
