@@ -1,0 +1,1 @@
+"""Helpers of assets/build.py: signed-distance modelling, meshing, weights, gaits."""
