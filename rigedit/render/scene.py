@@ -81,6 +81,9 @@ class RigScene:
                                            reset_camera=False)
         self.bone_actor.SetVisibility(show_skeleton)
         self.floor_actor = self._add_floor() if show_floor else None
+        self.display_mode = "solid"
+        self.weights_shown = False
+        self._weight_lut = None
         self.joint_positions = sk.bind_matrices[:, :3, 3].copy()
         self.view("front")
 
@@ -102,6 +105,68 @@ class RigScene:
     def set_skeleton_visible(self, visible):
         self.bone_actor.SetVisibility(bool(visible))
 
+    def set_floor_visible(self, visible):
+        for name in ("rig-floor", "rig-floor-grid"):
+            actor = self.plotter.actors.get(name)
+            if actor is not None:
+                actor.SetVisibility(bool(visible))
+
+    # ------------------------------------------------------------------ display modes
+    DISPLAY_MODES = ("solid", "translucent", "wireframe")
+
+    def set_display_mode(self, mode):
+        """Show the mesh ``"solid"``, ``"translucent"`` (see-through, with its wireframe, so
+        joints inside stay visible) or ``"wireframe"``."""
+        if mode not in self.DISPLAY_MODES:
+            raise ValueError(f"expected a display mode in {self.DISPLAY_MODES}, got {mode!r}")
+        prop = self.mesh_actor.GetProperty()
+        if mode == "wireframe":
+            prop.SetRepresentationToWireframe()
+            prop.SetOpacity(1.0)
+            prop.EdgeVisibilityOff()
+            prop.SetLineWidth(1.0)
+        else:
+            prop.SetRepresentationToSurface()
+            prop.SetOpacity(1.0 if mode == "solid" else 0.35)
+            prop.SetEdgeVisibility(mode == "translucent")
+            prop.SetEdgeColor(0.35, 0.33, 0.30)
+        self.display_mode = mode
+
+    def show_weights(self, weights):
+        """Colour the mesh by one joint's influence (weight paint view), or back to its plain
+        colour when ``weights`` is None.
+
+        Parameters
+        ----------
+        weights : (V,) float in [0, 1], or None
+        """
+        mapper = self.mesh_actor.GetMapper()
+        if weights is None:
+            mapper.ScalarVisibilityOff()
+            self.weights_shown = False
+            return
+        w = np.asarray(weights, dtype=np.float32).reshape(-1)
+        if w.shape[0] != self.mesh.n_points:
+            raise ValueError(f"expected {self.mesh.n_points} weights, got {w.shape[0]}")
+        self.mesh.point_data["weight"] = w
+        self.mesh.Modified()
+        if self._weight_lut is None:
+            lut = vtk.vtkLookupTable()
+            # Blue (no influence) through green and yellow to red (full), as painters expect.
+            lut.SetHueRange(0.667, 0.0)
+            lut.SetSaturationRange(0.85, 0.85)
+            lut.SetValueRange(0.95, 0.95)
+            lut.SetNumberOfTableValues(256)
+            lut.Build()
+            self._weight_lut = lut
+        mapper.SetLookupTable(self._weight_lut)
+        mapper.SetScalarModeToUsePointFieldData()
+        mapper.SelectColorArray("weight")
+        mapper.SetScalarRange(0.0, 1.0)
+        mapper.SetColorModeToMapScalars()
+        mapper.ScalarVisibilityOn()
+        self.weights_shown = True
+
     # ------------------------------------------------------------------ per frame
     def update(self, pose):
         """Skin ``pose`` and write it into the existing actors (no re-add, no render).
@@ -114,14 +179,16 @@ class RigScene:
         self.update_from_matrices(model)
         return model
 
-    def update_from_matrices(self, model):
-        """Same as :meth:`update` from model matrices already computed."""
-        palette = np.matmul(model, self.rig.skeleton.inverse_bind_matrices)
-        verts = self.rig.binding.skin(palette)
-        pts = self.mesh.points
-        pts[:] = verts
-        self.mesh.GetPoints().Modified()
-        self.mesh.Modified()
+    def update_from_matrices(self, model, skin=True):
+        """Same as :meth:`update` from model matrices already computed; ``skin=False``
+        moves the bones only (the mesh keeps its points)."""
+        if skin:
+            palette = np.matmul(model, self.rig.skeleton.inverse_bind_matrices)
+            verts = self.rig.binding.skin(palette)
+            pts = self.mesh.points
+            pts[:] = verts
+            self.mesh.GetPoints().Modified()
+            self.mesh.Modified()
         self.joint_positions = model[:, :3, 3].copy()
         self.bones.points[:] = self.joint_positions
         self.bones.GetPoints().Modified()

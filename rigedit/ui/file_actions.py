@@ -1,0 +1,201 @@
+"""The File menu's work: open, save, export, weights. Reading and computing run in a worker
+(:meth:`MainWindow.run_job`); a bad file gives one message naming it and keeps the current rig.
+"""
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+from PyQt5 import QtWidgets
+
+from ..io.atomic import write_json
+from ..io.skeleton_json import save_skeleton
+from ..io.weights_npz import load_weights, save_weights
+from .jobs import weights_in_chunks
+
+__all__ = ["FileActions", "pose_to_dict"]
+
+
+def pose_to_dict(pose):
+    """JSON-ready description of a pose (local transforms and Euler angles from rest)."""
+    joints = {}
+    for j, name in enumerate(pose.skeleton.names):
+        joints[name] = {"translation": pose.translation[j].round(9).tolist(),
+                        "rotation": pose.rotation[j].round(12).tolist(),
+                        "scale": pose.scale[j].round(9).tolist(),
+                        "euler_degrees_from_rest": pose.get_euler(j, degrees=True)
+                        .round(6).tolist()}
+    return {"format": "rigedit.pose", "version": 1, "rotation_order": "xyzw",
+            "joints": joints}
+
+
+def _load_folder(path):
+    from ..io.rig_folder import load_rig_folder
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # "weights computed" is expected, not an error
+        return load_rig_folder(path)
+
+
+class FileActions:
+    """File operations of a :class:`MainWindow` (kept apart to keep the window small)."""
+
+    def __init__(self, window):
+        self.w = window
+
+    @property
+    def doc(self):
+        return self.w.document
+
+    # ------------------------------------------------------------------ dialogs
+    def _ask_open(self, title, filters):
+        path, _ = QtWidgets.QFileDialog.getOpenFileName(self.w, title, "", filters)
+        return path or None
+
+    def _ask_save(self, title, name, filters):
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(self.w, title, name, filters)
+        return path or None
+
+    # ------------------------------------------------------------------ open
+    def open_folder(self, path=None):
+        """Open a rig folder (mesh, skeleton.json, optional weights and animations)."""
+        path = path or QtWidgets.QFileDialog.getExistingDirectory(self.w, "Open rig folder")
+        if not path:
+            return None
+        return self.w.run_job(f"Opening {Path(path).name}", lambda report: _load_folder(path),
+                              self._opened)
+
+    def open_mesh_skeleton(self, mesh_path=None, skeleton_path=None):
+        """Open a mesh file and a skeleton file; weights are computed."""
+        mesh_path = mesh_path or self._ask_open(
+            "Open mesh", "Meshes (*.obj *.ply *.stl *.vtk *.vtu *.vtp)")
+        if not mesh_path:
+            return None
+        skeleton_path = skeleton_path or self._ask_open("Open skeleton", "Skeleton (*.json)")
+        if not skeleton_path:
+            return None
+
+        def work(report):
+            from ..io.mesh import load_mesh
+            from ..io.skeleton_json import load_skeleton
+            from ..rig import Rig
+
+            report(None)
+            skeleton, meta = load_skeleton(skeleton_path)
+            vertices, faces = load_mesh(mesh_path)
+            indices, weights = weights_in_chunks(vertices, skeleton, report=report)
+            return Rig(skeleton, vertices, faces, indices, weights, name=Path(mesh_path).stem,
+                       up=meta["up"])
+
+        return self.w.run_job(f"Opening {Path(mesh_path).name}", work, self._opened)
+
+    def _opened(self, rig):
+        self.doc.set_rig(rig)
+        self.w.status(f"Opened {rig.name}: {len(rig.vertices):,} vertices, "
+                      f"{len(rig.skeleton)} joints, {len(rig.clips)} clips")
+
+    # ------------------------------------------------------------------ save
+    def save(self):
+        path = self.doc.rig.path
+        if path is None or not Path(path).is_dir():
+            return self.save_as()
+        return self.save_to(path)
+
+    def save_as(self, path=None):
+        path = path or QtWidgets.QFileDialog.getExistingDirectory(self.w, "Save rig into folder")
+        return self.save_to(path) if path else None
+
+    def save_to(self, path):
+        """Write the rig folder (each file atomically); the status bar says where."""
+        from ..io.rig_folder import save_rig_folder
+
+        rig = self.doc.rig
+        try:
+            save_rig_folder(path, rig)
+        except (ValueError, OSError) as exc:
+            self.w.error("Save rig", str(exc))
+            return False
+        rig.path = Path(path)
+        self.w.status(f"Saved {rig.name} to {path}")
+        return True
+
+    def export_pose(self, path=None):
+        path = path or self._ask_save("Export pose", "pose.json", "JSON (*.json)")
+        if not path:
+            return False
+        try:
+            write_json(path, pose_to_dict(self.doc.pose))
+        except (ValueError, OSError) as exc:
+            self.w.error("Export pose", str(exc))
+            return False
+        self.w.status(f"Exported the pose to {path}")
+        return True
+
+    def export_skeleton(self, path=None):
+        path = path or self._ask_save("Export skeleton", "skeleton.json", "JSON (*.json)")
+        if not path:
+            return False
+        try:
+            save_skeleton(path, self.doc.skeleton, up=self.doc.rig.up)
+        except (ValueError, OSError) as exc:
+            self.w.error("Export skeleton", str(exc))
+            return False
+        self.w.status(f"Exported the skeleton to {path}")
+        return True
+
+    # ------------------------------------------------------------------ weights
+    def load_weights(self, path=None):
+        """Replace the skin weights from a .npz file (one undo step)."""
+        path = path or self._ask_open("Load weights", "Weights (*.npz)")
+        if not path:
+            return False
+        rig = self.doc.rig
+        try:
+            indices, weights = load_weights(path, rig.skeleton, len(rig.vertices))
+            self.doc.set_weights(indices, weights, label=f"Load weights {Path(path).name}")
+        except (ValueError, OSError) as exc:
+            self.w.error("Load weights", str(exc))
+            return False
+        self.w.status(f"Loaded weights from {path}")
+        return True
+
+    def save_weights(self, path=None):
+        path = path or self._ask_save("Save weights", "weights.npz", "Weights (*.npz)")
+        if not path:
+            return False
+        b = self.doc.rig.binding
+        try:
+            save_weights(path, b.indices, b.weights, self.doc.skeleton.names)
+        except (ValueError, OSError) as exc:
+            self.w.error("Save weights", str(exc))
+            return False
+        self.w.status(f"Saved weights to {path}")
+        return True
+
+    def recompute_weights(self):
+        """Recompute the weights off the UI thread (progress, cancel); one undo step."""
+        rig = self.doc.rig
+        vertices, skeleton = rig.vertices, rig.skeleton
+
+        def done(result):
+            if self.doc.rig is not rig:
+                return  # another rig was opened meanwhile
+            self.doc.set_weights(*result, label="Recompute weights")
+            self.w.status(f"Recomputed weights for {len(vertices):,} vertices")
+
+        return self.w.run_job("Computing weights",
+                              lambda report: weights_in_chunks(vertices, skeleton,
+                                                               report=report), done)
+
+    def save_screenshot(self, path=None):
+        path = path or self._ask_save("Save screenshot", "rigedit.png", "PNG (*.png)")
+        if not path:
+            return False
+        try:
+            self.w.screenshot(path)
+        except OSError as exc:
+            self.w.error("Screenshot", str(exc))
+            return False
+        self.w.status(f"Saved a screenshot to {path}")
+        return True
+

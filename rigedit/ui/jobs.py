@@ -1,0 +1,95 @@
+"""Long work off the UI thread: a QThread running a pure function with progress and cancel.
+
+The function never touches Qt widgets or VTK; it reports progress through ``report(fraction)``,
+which raises :class:`Cancelled` once the user pressed Cancel. Results come back on the main
+thread through Qt signals, where the caller applies them (VTK calls stay on the main thread).
+"""
+from __future__ import annotations
+
+import threading
+import traceback
+
+import numpy as np
+from PyQt5 import QtCore
+
+__all__ = ["Cancelled", "Job", "weights_in_chunks"]
+
+
+class Cancelled(Exception):
+    """The user cancelled the job."""
+
+
+class Job(QtCore.QThread):
+    """Run ``fn(report)`` in a thread.
+
+    Signals
+    -------
+    progress(int)      percent done, 0-100 (-1 when the job cannot tell)
+    succeeded(object)  the function's result
+    failed(str)        one-line error message (ValueError and RigFileError keep their text)
+    cancelled()
+    """
+
+    progress = QtCore.pyqtSignal(int)
+    succeeded = QtCore.pyqtSignal(object)
+    failed = QtCore.pyqtSignal(str)
+    cancelled = QtCore.pyqtSignal()
+
+    def __init__(self, label, fn, parent=None):
+        super().__init__(parent)
+        self.label = label
+        self.fn = fn
+        self._cancel = threading.Event()
+
+    def cancel(self):
+        self._cancel.set()
+
+    @property
+    def is_cancelled(self):
+        return self._cancel.is_set()
+
+    def report(self, fraction):
+        if self._cancel.is_set():
+            raise Cancelled()
+        self.progress.emit(-1 if fraction is None else int(round(100 * fraction)))
+
+    def run(self):
+        try:
+            result = self.fn(self.report)
+            if self._cancel.is_set():
+                raise Cancelled()
+        except Cancelled:
+            self.cancelled.emit()
+        except (ValueError, KeyError, OSError) as exc:
+            self.failed.emit(str(exc).strip("'\""))
+        except Exception as exc:  # noqa: BLE001 - shown to the user, never a silent thread death
+            traceback.print_exc()
+            self.failed.emit(f"{type(exc).__name__}: {exc}")
+        else:
+            self.succeeded.emit(result)
+
+
+def weights_in_chunks(vertices, skeleton, method="idw", report=None, chunk=4096):
+    """Compute skin weights a block of vertices at a time so progress shows and a cancel is
+    honoured between blocks (each vertex's weights depend on it alone for the ``idw`` method).
+
+    Returns
+    -------
+    indices : (V, K) int32
+    weights : (V, K) float64
+    """
+    from ..model.weights import compute_weights
+
+    if method != "idw":  # global methods (bone heat) cannot be split by vertex
+        if report:
+            report(None)
+        return compute_weights(vertices, skeleton, method)
+    parts_i, parts_w = [], []
+    n = len(vertices)
+    for lo in range(0, n, chunk):
+        i, w = compute_weights(vertices[lo:lo + chunk], skeleton, method)
+        parts_i.append(i)
+        parts_w.append(w)
+        if report:
+            report(min(1.0, (lo + chunk) / n))
+    return np.vstack(parts_i), np.vstack(parts_w)

@@ -1,0 +1,661 @@
+"""The editor window: 3D view with joint gizmos, joint and info panels, menus, undo.
+
+Data flow: user input -> :class:`~rigedit.document.Document` methods -> document events ->
+:meth:`MainWindow._on_document` refreshes the views. Widgets never talk to each other.
+"""
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+from PyQt5 import QtCore, QtGui, QtWidgets
+from pyvistaqt import QtInteractor
+
+from ..document import Document
+from ..model.ik import drag_joint
+from ..render.gizmos import AxisHandles, JointGizmos, gizmo_radius
+from ..render.scene import RigScene
+from .file_actions import FileActions
+from .joint_panel import InfoPanel, JointPanel
+from .jobs import Job, weights_in_chunks
+
+__all__ = ["MainWindow", "default_rig"]
+
+BACKGROUND = ("#3a3f47", "#1d2026")  # bottom, top gradient
+
+
+def default_rig():
+    """The bundled quadruped, or the code-built creature when the assets are not installed.
+
+    Returns
+    -------
+    rig : Rig
+    note : str or None
+        Why the fallback was used.
+    """
+    import rigedit
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return rigedit.load_rig(), None
+    except (ValueError, OSError) as exc:
+        from .fallback import demo_rig
+
+        return demo_rig(), f"bundled quadruped not available ({exc}); showing a demo creature"
+
+
+class MainWindow(QtWidgets.QMainWindow):
+    """The rig editor.
+
+    Parameters
+    ----------
+    rig : Rig, optional
+        The default character when omitted.
+
+    Attributes
+    ----------
+    document : Document
+        Single source of truth: rig, pose, clips, time, selection, undo stack.
+    plotter : pyvistaqt.QtInteractor
+    scene : RigScene
+    gizmos : JointGizmos
+        ``gizmos.widgets[j]`` is joint ``j``'s vtkSphereWidget.
+    mode : {"pose", "edit"}
+    axis : int or None
+        Drag constraint axis (0, 1, 2) or None for free dragging.
+    chain_length : int
+        IK chain length of a pose-mode drag.
+    """
+
+    def __init__(self, rig=None, parent=None):
+        super().__init__(parent)
+        note = None
+        if rig is None:
+            rig, note = default_rig()
+        self.setWindowTitle("rigedit")
+        self.document = Document(rig)
+        self.axis = None
+        self.chain_length = 2
+        self.last_error = None
+        self.job = None
+        self.gizmos = None
+        self.axes = None
+        self._drag = None
+        self._interacting = False
+        self._weights_view = False
+        self._build_view()
+        self.files = FileActions(self)
+        self._build_actions()
+        self._build_panels()
+        self._install_docks()
+        self._build_status_bar()
+        self.document.subscribe(self._on_document)
+        self._load_scene()
+        self.resize(1440, 900)
+        self.status(note or f"Loaded {rig.name}: drag a joint sphere to pose; "
+                            f"Ctrl+Z undoes")
+
+    # ================================================================== construction
+    def _build_view(self):
+        self.plotter = QtInteractor(self, multi_samples=0, auto_update=False)
+        self.plotter.set_background(BACKGROUND[0], top=BACKGROUND[1])
+        self.plotter.enable_anti_aliasing = None
+        self.setCentralWidget(self.plotter)
+
+    def _action(self, text, slot, shortcut=None, checkable=False, checked=False, tip=None):
+        act = QtWidgets.QAction(text, self)
+        if shortcut:
+            act.setShortcut(QtGui.QKeySequence(shortcut))
+        act.setCheckable(checkable)
+        if checkable:
+            act.setChecked(checked)
+            act.toggled.connect(slot)
+        else:
+            act.triggered.connect(slot)
+        if tip:
+            act.setStatusTip(tip)
+            act.setToolTip(tip)
+        return act
+
+    def _build_actions(self):
+        f = self.files
+        bar = self.menuBar()
+        m = bar.addMenu("&File")
+        m.addAction(self._action("&Open rig folder...", f.open_folder, "Ctrl+O"))
+        m.addAction(self._action("Open mesh + skeleton...", f.open_mesh_skeleton))
+        m.addSeparator()
+        m.addAction(self._action("&Save rig", f.save, "Ctrl+S"))
+        m.addAction(self._action("Save rig &as...", f.save_as, "Ctrl+Shift+S"))
+        m.addSeparator()
+        m.addAction(self._action("Export pose (JSON)...", f.export_pose))
+        m.addAction(self._action("Export skeleton (JSON)...", f.export_skeleton))
+        m.addSeparator()
+        m.addAction(self._action("Load weights...", f.load_weights))
+        m.addAction(self._action("Save weights...", f.save_weights))
+        m.addAction(self._action("&Recompute weights", f.recompute_weights, "Ctrl+R"))
+        m.addSeparator()
+        m.addAction(self._action("Save screenshot...", f.save_screenshot))
+        m.addAction(self._action("&Quit", self.close, "Ctrl+Q"))
+
+        m = bar.addMenu("&Edit")
+        self.undo_action = self._action("&Undo", self.document.undo, QtGui.QKeySequence.Undo)
+        self.redo_action = self._action("&Redo", self.document.redo, QtGui.QKeySequence.Redo)
+        m.addAction(self.undo_action)
+        m.addAction(self.redo_action)
+        m.addSeparator()
+        m.addAction(self._action("Reset joint", self._reset_selected, "Alt+R"))
+        m.addAction(self._action("Reset pose", self.document.reset_pose, "Alt+Shift+R"))
+        m.addAction(self._action("Mirror pose L → R", lambda: self.document.mirror_pose("L")))
+        m.addAction(self._action("Mirror pose R → L", lambda: self.document.mirror_pose("R")))
+
+        view = bar.addMenu("&View")
+        self.display_group = QtWidgets.QActionGroup(self)
+        self.display_actions = {}
+        for key, (mode, label) in enumerate((("solid", "Solid"),
+                                             ("translucent", "Translucent + wireframe"),
+                                             ("wireframe", "Wireframe")), start=1):
+            act = self._action(label, lambda on, m_=mode: on and self.set_display_mode(m_),
+                               f"Ctrl+{key}", checkable=True, checked=mode == "solid")
+            self.display_group.addAction(act)
+            self.display_actions[mode] = act
+            view.addAction(act)
+        view.addSeparator()
+        self.skeleton_action = self._action("Show skeleton", self.set_skeleton_visible, "Ctrl+B",
+                                            checkable=True, checked=True)
+        self.gizmos_action = self._action("Show joint gizmos", self.set_gizmos_visible, "Ctrl+G",
+                                          checkable=True, checked=True)
+        self.weights_action = self._action(
+            "Weight paint view", self.set_weights_view, "Ctrl+W", checkable=True,
+            tip="Colour the mesh by the selected joint's influence (blue 0 → red 1)")
+        self.floor_action = self._action("Show floor", self._set_floor_visible,
+                                         checkable=True, checked=True)
+        for a in (self.skeleton_action, self.gizmos_action, self.weights_action,
+                  self.floor_action):
+            view.addAction(a)
+        view.addSeparator()
+        self.camera_actions = []
+        for key, name in (("1", "front"), ("3", "side"), ("7", "top"), ("Ctrl+3", "back")):
+            act = self._action(f"{name.capitalize()} view", lambda _=False, n=name: self.view(n),
+                               key)
+            self.camera_actions.append(act)
+            view.addAction(act)
+        view.addAction(self._action("Reset camera", lambda: self.view("front"), "Home"))
+
+        tb = self.addToolBar("Tools")
+        tb.setObjectName("tools")
+        tb.setMovable(False)
+        tb.setIconSize(QtCore.QSize(16, 16))
+        tb.setToolButtonStyle(QtCore.Qt.ToolButtonTextOnly)
+        tb.addWidget(QtWidgets.QLabel(" Mode "))
+        self.mode_group = QtWidgets.QActionGroup(self)
+        self.pose_mode_action = self._action("Pose", lambda on: on and self.set_mode("pose"),
+                                             "Tab", checkable=True, checked=True,
+                                             tip="Pose mode: drag a joint to rotate its chain")
+        self.edit_mode_action = self._action(
+            "Edit (bind)", lambda on: on and self.set_mode("edit"), "Shift+Tab", checkable=True,
+            tip="Edit mode: drag a joint to move its rest position; the skin is re-bound")
+        for a in (self.pose_mode_action, self.edit_mode_action):
+            self.mode_group.addAction(a)
+            tb.addAction(a)
+        tb.addSeparator()
+        tb.addWidget(QtWidgets.QLabel(" IK chain "))
+        self.chain_spin = QtWidgets.QSpinBox()
+        self.chain_spin.setRange(1, 8)
+        self.chain_spin.setValue(self.chain_length)
+        self.chain_spin.setToolTip("Joints above the dragged one that rotate to reach it "
+                                   "(1: just aim the parent bone)")
+        self.chain_spin.valueChanged.connect(lambda v: setattr(self, "chain_length", int(v)))
+        tb.addWidget(self.chain_spin)
+        tb.addSeparator()
+        tb.addWidget(QtWidgets.QLabel(" Axis "))
+        self.axis_group = QtWidgets.QActionGroup(self)
+        self.axis_actions = []
+        for k, label in enumerate(("Free", "X", "Y", "Z")):
+            act = self._action(label, lambda on, a=k - 1: on and self.set_axis(None if a < 0 else a),
+                               None if k == 0 else f"Shift+{label}", checkable=True,
+                               checked=k == 0, tip="Constrain drags to this axis" if k else
+                               "Drag freely in the view plane")
+            self.axis_group.addAction(act)
+            self.axis_actions.append(act)
+            tb.addAction(act)
+        tb.addSeparator()
+        for mode in ("solid", "translucent", "wireframe"):
+            tb.addAction(self.display_actions[mode])
+        tb.addSeparator()
+        tb.addAction(self.skeleton_action)
+        tb.addAction(self.gizmos_action)
+        tb.addAction(self.weights_action)
+        tb.addSeparator()
+        for act in self.camera_actions[:3]:
+            tb.addAction(act)
+        reset = self._action("Reset view", lambda: self.view("front"))
+        tb.addAction(reset)
+        self.toolbar = tb
+
+    def _build_panels(self):
+        self.joint_panel = JointPanel()
+        p = self.joint_panel
+        d = self.document
+        p.joint_clicked.connect(d.select)
+        p.euler_changed.connect(lambda j, a: d.set_joint_euler(j, a))
+        p.slider_pressed.connect(d.begin_drag)
+        p.euler_dragged.connect(self._euler_live)
+        p.slider_released.connect(self._slider_released)
+        p.translation_changed.connect(lambda j, t: d.set_joint_translation(j, t))
+        p.scale_changed.connect(lambda j, s: d.set_joint_scale(j, s))
+        p.reset_joint.connect(d.reset_joint)
+        p.reset_pose.connect(d.reset_pose)
+        p.mirror.connect(d.mirror_pose)
+        self.info_panel = InfoPanel()
+
+    def _install_docks(self):
+        """Where docks go. Right: joints and info. The bottom area is left free for the
+        timeline (``self.addDockWidget(Qt.BottomDockWidgetArea, TimelineDock(self))``)."""
+        self.joint_dock = QtWidgets.QDockWidget("Joints", self)
+        self.joint_dock.setObjectName("joints")
+        self.joint_dock.setWidget(self.joint_panel)
+        self.joint_dock.setMinimumWidth(330)
+        self.addDockWidget(QtCore.Qt.RightDockWidgetArea, self.joint_dock)
+        self.info_dock = QtWidgets.QDockWidget("Info", self)
+        self.info_dock.setObjectName("info")
+        self.info_dock.setWidget(self.info_panel)
+        self.addDockWidget(QtCore.Qt.RightDockWidgetArea, self.info_dock)
+        self.setCorner(QtCore.Qt.BottomRightCorner, QtCore.Qt.RightDockWidgetArea)
+        view = self.menuBar().actions()[2].menu()
+        view.addSeparator()
+        view.addAction(self.joint_dock.toggleViewAction())
+        view.addAction(self.info_dock.toggleViewAction())
+
+    def _build_status_bar(self):
+        sb = self.statusBar()
+        self.progress = QtWidgets.QProgressBar()
+        self.progress.setMaximumWidth(220)
+        self.progress.setVisible(False)
+        self.cancel_button = QtWidgets.QPushButton("Cancel")
+        self.cancel_button.setVisible(False)
+        self.cancel_button.clicked.connect(self.cancel_job)
+        self.mode_label = QtWidgets.QLabel()
+        sb.addPermanentWidget(self.progress)
+        sb.addPermanentWidget(self.cancel_button)
+        sb.addPermanentWidget(self.mode_label)
+
+    # ================================================================== scene
+    def _load_scene(self):
+        """(Re)build the 3D scene and panels for the document's rig."""
+        if self.gizmos is not None:
+            self.gizmos.remove()
+        self.plotter.clear()
+        rig = self.document.rig
+        self.scene = RigScene(self.plotter, rig, show_skeleton=self.skeleton_action.isChecked())
+        self.scene.bone_actor.GetProperty().SetLineWidth(4)
+        self.scene.set_display_mode(self.display_mode())
+        self.scene.set_floor_visible(self.floor_action.isChecked())
+        self.radius = gizmo_radius(rig)
+        self.gizmos = JointGizmos(self.plotter, self.scene.joint_positions, self.radius,
+                                  self._drag_start, self._drag_move, self._drag_end)
+        self.gizmos.set_visible(self.gizmos_action.isChecked())
+        self.axes = AxisHandles(self.plotter, 6 * self.radius)
+        self.axes.set_axis(self.axis)
+        self.joint_panel.set_skeleton(rig.skeleton)
+        self.info_panel.show_rig(rig)
+        self.info_panel.show_selection(rig, None)
+        self.setWindowTitle(f"rigedit — {rig.name}")
+        self._refresh_pose()
+        self._update_undo_actions()
+        self._update_mode_label()
+        self.plotter.update()
+
+    def shown_pose(self):
+        """The pose on screen: the document's in pose mode, the rest pose in edit mode."""
+        return self.document.pose if self.mode == "pose" else self.document.rig.rest_pose()
+
+    @property
+    def mode(self):
+        return self.document.mode
+
+    def _refresh_pose(self, skin=True):
+        model = self.document.rig.joint_matrices(self.shown_pose())
+        self.scene.update_from_matrices(model, skin=skin)
+        heads = model[:, :3, 3]
+        self.gizmos.set_positions(heads, skip=self.gizmos.active)
+        j = self.document.selection
+        if j is not None:
+            self.axes.set_position(heads[j])
+        return model
+
+    def request_render(self):
+        """Ask Qt to repaint the view once; inside a widget drag VTK renders by itself."""
+        if not self._interacting:
+            self.plotter.update()
+
+    def show_pose(self, pose):
+        """Show ``pose`` (a Pose or (J, 10) snapshot) as the current pose, without an undo
+        step (for playback and scrubbing); the view and gizmos follow."""
+        self.document.set_pose(pose)
+
+    # ================================================================== document events
+    def _on_document(self, event, **info):
+        d = self.document
+        if event == "rig":
+            self._load_scene()
+        elif event == "pose":
+            self._refresh_pose()
+            if not d.dragging or not self._interacting:
+                self.joint_panel.show_joint(d.selection, d.pose)
+            self.request_render()
+        elif event == "rest":
+            self.info_panel.show_rig(d.rig)
+            if self._weights_view:
+                self._show_weights()
+        elif event == "selection":
+            j = info.get("joint")
+            self.gizmos.set_selected(j)
+            self.joint_panel.show_joint(j, d.pose)
+            self.info_panel.show_selection(d.rig, j)
+            self.axes.set_visible(j is not None and self.gizmos.visible)
+            if j is not None:
+                self.axes.set_position(self.scene.joint_positions[j])
+                self.status(f"Selected {d.skeleton.names[j]}")
+            if self._weights_view:
+                self._show_weights()
+            self.request_render()
+        elif event == "undo":
+            self._update_undo_actions()
+
+    def _update_undo_actions(self):
+        s = self.document.undo_stack
+        self.undo_action.setEnabled(s.can_undo)
+        self.redo_action.setEnabled(s.can_redo)
+        self.undo_action.setText(f"&Undo {s.undo_label}".strip())
+        self.redo_action.setText(f"&Redo {s.redo_label}".strip())
+
+    # ================================================================== view options
+    def display_mode(self):
+        return next(m for m, a in self.display_actions.items() if a.isChecked())
+
+    def set_display_mode(self, mode):
+        """"solid", "translucent" (with wireframe) or "wireframe"."""
+        self.display_actions[mode].setChecked(True)
+        self.scene.set_display_mode(mode)
+        self.request_render()
+
+    def set_skeleton_visible(self, on):
+        self.skeleton_action.setChecked(bool(on))
+        self.scene.set_skeleton_visible(on)
+        self.request_render()
+
+    def set_gizmos_visible(self, on):
+        self.gizmos_action.setChecked(bool(on))
+        self.gizmos.set_visible(on)
+        self.axes.set_visible(bool(on) and self.document.selection is not None)
+        self.request_render()
+
+    def _set_floor_visible(self, on):
+        self.scene.set_floor_visible(on)
+        self.request_render()
+
+    def set_weights_view(self, on):
+        """Weight paint view: colour the mesh by the selected joint's influence."""
+        self.weights_action.setChecked(bool(on))
+        self._weights_view = bool(on)
+        self._show_weights()
+        self.request_render()
+
+    def _show_weights(self):
+        j = self.document.selection
+        if not self._weights_view:
+            self.scene.show_weights(None)
+            return
+        rig = self.document.rig
+        w = (np.zeros(len(rig.vertices)) if j is None
+             else rig.weights[:, j].toarray().ravel())
+        self.scene.show_weights(w)
+
+    def view(self, name):
+        """Camera preset: "front", "side", "top" or "back"."""
+        self.scene.view(name)
+        self.request_render()
+
+    def set_axis(self, axis):
+        """Constrain drags to model axis 0, 1 or 2 (X, Y, Z), or free (None)."""
+        self.axis = axis
+        self.axis_actions[0 if axis is None else axis + 1].setChecked(True)
+        self.axes.set_axis(axis)
+        self.request_render()
+
+    def set_mode(self, mode):
+        """"pose" (drag poses the character) or "edit" (drag moves rest positions)."""
+        if mode not in ("pose", "edit"):
+            raise ValueError(f"expected mode 'pose' or 'edit', got {mode!r}")
+        (self.pose_mode_action if mode == "pose" else self.edit_mode_action).setChecked(True)
+        if mode == self.document.mode:
+            return
+        self.document.mode = mode
+        self._refresh_pose()
+        self._update_mode_label()
+        self.status("Edit mode: drag a joint to move its rest position; the skin is re-bound "
+                    "on release" if mode == "edit" else "Pose mode")
+        self.request_render()
+
+    def _update_mode_label(self):
+        self.mode_label.setText(f"  {self.mode.upper()} MODE  ")
+        self.mode_label.setStyleSheet(
+            "color: #ffd27a; font-weight: bold" if self.mode == "edit" else "color: #9fd0ff")
+
+    # ================================================================== gizmo drags
+    def _drag_start(self, j):
+        d = self.document
+        if self.job is not None:
+            self.status("Busy: wait for the current job or cancel it")
+        d.select(j)
+        self._interacting = True
+        self._drag = {"joint": j, "start": self.gizmos.center(j),
+                      "pose": d.pose_snapshot(), "work": d.pose.copy()}
+        if self.mode == "pose":
+            d.begin_drag()
+
+    def _constrain(self, start, center):
+        if self.axis is None:
+            return center
+        e = np.eye(3)[self.axis]
+        return start + np.dot(center - start, e) * e
+
+    def _drag_move(self, j, center):
+        drag = self._drag
+        if drag is None or drag["joint"] != j:
+            return
+        target = self._constrain(drag["start"], center)
+        if self.axis is not None:
+            self.gizmos.set_center(j, target)
+        drag["target"] = target
+        if self.mode == "pose":
+            self.drag_step(j, target)
+        else:
+            rest = self.document.rig.joint_matrices(self.document.rig.rest_pose())
+            heads = rest[:, :3, 3].copy()
+            heads[j] = target
+            self.scene.bones.points[:] = heads
+            self.scene.bones.Modified()
+            self.axes.set_position(target)
+
+    def drag_step(self, j, target):
+        """One pose-mode drag step: IK from the pose at drag start, then FK, skinning and the
+        actors' points updated in place (no render; the caller or VTK renders)."""
+        work = self._drag["work"]
+        work.set_array(self._drag["pose"])
+        drag_joint(self.document.skeleton, work, j, target, self.chain_length,
+                   fk=self.document.rig.joint_matrices)
+        self.document.set_pose(work)
+
+    def _drag_end(self, j):
+        drag, self._drag = self._drag, None
+        self._interacting = False
+        if drag is None:
+            return
+        d = self.document
+        name = d.skeleton.names[j]
+        if self.mode == "pose":
+            d.end_drag(f"Drag {name}")
+            # Snap the sphere onto where the joint really is (it may not reach the mouse).
+            self.gizmos.set_center(j, self.scene.joint_positions[j])
+            self.status(f"Posed {name}")
+        elif "target" in drag and not np.allclose(drag["target"], drag["start"]):
+            self.rebind_moved_joint(j, drag["target"])
+        self.request_render()
+
+    def _euler_live(self, j, angles):
+        self.document.begin_drag()
+        self.document.pose.set_euler(j, angles, degrees=True)
+        self.document.set_pose(self.document.pose, joints=[j])
+
+    def _slider_released(self):
+        j = self.document.selection
+        self.document.end_drag(f"Rotate {self.document.skeleton.names[j]}" if j is not None
+                               else "Rotate")
+
+    def _reset_selected(self):
+        if self.document.selection is not None:
+            self.document.reset_joint(self.document.selection)
+
+    # ================================================================== bind mode
+    def rebind_moved_joint(self, j, head):
+        """Move joint ``j``'s rest position to ``head`` and re-bind the skin in a worker."""
+        from ..document import skeleton_with_moved_joint
+
+        d = self.document
+        before = d.rest_state()
+        skeleton = skeleton_with_moved_joint(d.skeleton, j, head)
+        vertices = d.rig.vertices
+        name = d.skeleton.names[j]
+
+        def done(result):
+            indices, weights = result
+            pose = before[3].copy()
+            delta = skeleton.rest_translation - before[0].rest_translation
+            pose[:, :3] += delta  # keep the pose's offsets from rest
+            d.push_rest_edit(f"Move {name} (rest)", before, (skeleton, indices, weights, pose))
+            self.status(f"Moved {name}'s rest position and re-bound the skin "
+                        f"({len(vertices):,} vertices)")
+
+        def cancelled():
+            self._refresh_pose()
+            self.request_render()
+            self.status(f"Re-bind cancelled; {name} keeps its rest position")
+
+        self.run_job(f"Re-binding after moving {name}",
+                     lambda report: weights_in_chunks(vertices, skeleton, report=report),
+                     done, cancelled)
+
+    # ================================================================== jobs
+    def run_job(self, label, fn, on_done, on_cancel=None):
+        """Run ``fn(report)`` off the UI thread with a progress bar and a Cancel button;
+        ``on_done(result)`` runs on the main thread. Returns the :class:`Job`."""
+        if self.job is not None:
+            self.error("Busy", f"wait for '{self.job.label}' to finish, or cancel it")
+            return None
+        job = Job(label, fn, self)
+        self.job = job
+        self.progress.setRange(0, 100)
+        self.progress.setValue(0)
+        self.progress.setFormat(f"{label}: %p%")
+        self.progress.setVisible(True)
+        self.cancel_button.setVisible(True)
+
+        def progress(p):
+            if p < 0:
+                self.progress.setRange(0, 0)
+            else:
+                self.progress.setRange(0, 100)
+                self.progress.setValue(p)
+
+        def finish():
+            self.job = None
+            self.progress.setVisible(False)
+            self.cancel_button.setVisible(False)
+
+        def ok(result):
+            finish()
+            try:
+                on_done(result)
+            except ValueError as exc:
+                self.error(label, str(exc))
+
+        def failed(msg):
+            finish()
+            self.error(label, msg)
+            if on_cancel:
+                on_cancel()
+
+        def cancelled():
+            finish()
+            self.status(f"{label}: cancelled")
+            if on_cancel:
+                on_cancel()
+
+        job.progress.connect(progress)
+        job.succeeded.connect(ok)
+        job.failed.connect(failed)
+        job.cancelled.connect(cancelled)
+        job.finished.connect(job.deleteLater)
+        self.status(f"{label}...")
+        job.start()
+        return job
+
+    def cancel_job(self):
+        if self.job is not None:
+            self.job.cancel()
+
+    # ================================================================== messages
+    def status(self, text, timeout=0):
+        self.statusBar().showMessage(text, timeout)
+
+    def error(self, title, message):
+        """Show one clear message: a dialog (not blocking) and the status bar."""
+        self.last_error = message
+        self.status(f"Error: {message}")
+        box = QtWidgets.QMessageBox(QtWidgets.QMessageBox.Warning, title, message,
+                                    QtWidgets.QMessageBox.Ok, self)
+        box.setAttribute(QtCore.Qt.WA_DeleteOnClose)
+        box.open()
+        self._last_dialog = box
+
+    # ================================================================== screenshot, close
+    def screenshot(self, path=None):
+        """Image of the whole window with the 3D view in it; saved when ``path`` is given.
+
+        Returns
+        -------
+        QImage
+        """
+        self.plotter.render()
+        QtWidgets.QApplication.processEvents()
+        self.plotter.render()
+        image = self.grab().toImage()
+        # The GL view is a native window that grab() may not capture: paint its own image in.
+        view = self.plotter.screenshot(return_img=True)
+        h, w = view.shape[:2]
+        view = np.ascontiguousarray(view[:, :, :3])
+        qimg = QtGui.QImage(view.data, w, h, 3 * w, QtGui.QImage.Format_RGB888)
+        top_left = self.plotter.mapTo(self, QtCore.QPoint(0, 0))
+        ratio = self.devicePixelRatioF()
+        painter = QtGui.QPainter(image)
+        painter.drawImage(QtCore.QRectF(top_left.x() * ratio, top_left.y() * ratio,
+                                        self.plotter.width() * ratio,
+                                        self.plotter.height() * ratio), qimg)
+        painter.end()
+        if path is not None:
+            Path(path).parent.mkdir(parents=True, exist_ok=True)
+            if not image.save(str(path)):
+                raise OSError(f"{path}: cannot write the screenshot")
+        return image
+
+    def closeEvent(self, event):
+        if self.job is not None:
+            self.job.cancel()
+            self.job.wait(5000)
+        if self.gizmos is not None:
+            self.gizmos.remove()
+        self.plotter.close()
+        super().closeEvent(event)
