@@ -13,7 +13,7 @@ import numpy as np
 import pyvista as pv
 import vtk
 
-__all__ = ["JointGizmos", "AxisHandles", "gizmo_radius", "AXIS_COLORS"]
+__all__ = ["JointGizmos", "AxisHandles", "gizmo_radius", "overlay_renderer", "AXIS_COLORS"]
 
 SPHERE_COLOR = (0.55, 0.78, 1.0)
 SELECTED_COLOR = (1.0, 0.62, 0.10)
@@ -34,6 +34,28 @@ def gizmo_radius(rig):
     if len(lengths):
         r = min(r, 0.3 * float(np.median(lengths)))
     return max(r, 1e-4 * extent)
+
+
+def overlay_renderer(plotter):
+    """A renderer drawn over the plotter's own, sharing its camera, so bones and joint
+    gizmos stay visible inside an opaque mesh (what "in front" does in other 3D tools).
+
+    Created once per plotter; its depth buffer is cleared, so its actors hide each other
+    correctly but never hide behind the mesh. It does not take camera interaction.
+    """
+    existing = getattr(plotter, "_rigedit_overlay", None)
+    if existing is not None:
+        return existing
+    ren_win = plotter.render_window
+    ren = vtk.vtkRenderer()
+    ren.SetLayer(1)
+    ren.InteractiveOff()
+    ren.SetActiveCamera(plotter.renderer.GetActiveCamera())
+    ren.SetViewport(plotter.renderer.GetViewport())
+    ren_win.SetNumberOfLayers(max(2, ren_win.GetNumberOfLayers()))
+    ren_win.AddRenderer(ren)
+    plotter._rigedit_overlay = ren
+    return ren
 
 
 def _sphere_widget_list(plotter):

@@ -90,6 +90,7 @@ class JointPanel(QtWidgets.QWidget):
             t = self._box(-1e4, 1e4, 3, self._translation_typed)
             s = self._box(0.001, 1000.0, 3, self._scale_typed)
             s.setSingleStep(0.05)
+            s.setValue(1.0)
             grid.addWidget(t, 1, k * 2 + 1)
             grid.addWidget(s, 2, k * 2 + 1)
             self.translation_boxes.append(t)

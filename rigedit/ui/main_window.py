@@ -14,7 +14,7 @@ from pyvistaqt import QtInteractor
 
 from ..document import Document
 from ..model.ik import drag_joint
-from ..render.gizmos import AxisHandles, JointGizmos, gizmo_radius
+from ..render.gizmos import AxisHandles, JointGizmos, gizmo_radius, overlay_renderer
 from ..render.scene import RigScene
 from .file_actions import FileActions
 from .joint_panel import InfoPanel, JointPanel
@@ -101,7 +101,6 @@ class MainWindow(QtWidgets.QMainWindow):
     def _build_view(self):
         self.plotter = QtInteractor(self, multi_samples=0, auto_update=False)
         self.plotter.set_background(BACKGROUND[0], top=BACKGROUND[1])
-        self.plotter.enable_anti_aliasing = None
         self.setCentralWidget(self.plotter)
 
     def _action(self, text, slot, shortcut=None, checkable=False, checked=False, tip=None):
@@ -181,7 +180,7 @@ class MainWindow(QtWidgets.QMainWindow):
                                key)
             self.camera_actions.append(act)
             view.addAction(act)
-        view.addAction(self._action("Reset camera", lambda: self.view("front"), "Home"))
+        view.addAction(self._action("Reset camera", lambda: self.view("reset"), "Home"))
 
         tb = self.addToolBar("Tools")
         tb.setObjectName("tools")
@@ -230,7 +229,7 @@ class MainWindow(QtWidgets.QMainWindow):
         tb.addSeparator()
         for act in self.camera_actions[:3]:
             tb.addAction(act)
-        reset = self._action("Reset view", lambda: self.view("front"))
+        reset = self._action("Reset view", lambda: self.view("reset"))
         tb.addAction(reset)
         self.toolbar = tb
 
@@ -287,16 +286,24 @@ class MainWindow(QtWidgets.QMainWindow):
         if self.gizmos is not None:
             self.gizmos.remove()
         self.plotter.clear()
+        self.plotter.enable_lightkit()  # clear() removed the lights too
         rig = self.document.rig
         self.scene = RigScene(self.plotter, rig, show_skeleton=self.skeleton_action.isChecked())
         self.scene.bone_actor.GetProperty().SetLineWidth(4)
+        # Bones, joint spheres and axis handles are drawn over the mesh, as "in front".
+        self.overlay = overlay_renderer(self.plotter)
+        self.overlay.RemoveAllViewProps()
+        self.plotter.renderer.RemoveActor(self.scene.bone_actor)
+        self.overlay.AddActor(self.scene.bone_actor)
+        self.scene.view("front", angle=35)
         self.scene.set_display_mode(self.display_mode())
         self.scene.set_floor_visible(self.floor_action.isChecked())
         self.radius = gizmo_radius(rig)
         self.gizmos = JointGizmos(self.plotter, self.scene.joint_positions, self.radius,
-                                  self._drag_start, self._drag_move, self._drag_end)
+                                  self._drag_start, self._drag_move, self._drag_end,
+                                  renderer=self.overlay)
         self.gizmos.set_visible(self.gizmos_action.isChecked())
-        self.axes = AxisHandles(self.plotter, 6 * self.radius)
+        self.axes = AxisHandles(self.plotter, 6 * self.radius, renderer=self.overlay)
         self.axes.set_axis(self.axis)
         self.joint_panel.set_skeleton(rig.skeleton)
         self.info_panel.show_rig(rig)
@@ -414,8 +421,11 @@ class MainWindow(QtWidgets.QMainWindow):
         self.scene.show_weights(w)
 
     def view(self, name):
-        """Camera preset: "front", "side", "top" or "back"."""
-        self.scene.view(name)
+        """Camera preset: "front", "side", "top", "back" or "reset" (three-quarter view)."""
+        if name == "reset":
+            self.scene.view("front", angle=35)
+        else:
+            self.scene.view(name)
         self.request_render()
 
     def set_axis(self, axis):
