@@ -328,28 +328,38 @@ class Document:
 
     # ------------------------------------------------------------------ rest pose and binding
     def rest_state(self):
-        """What a bind-mode edit changes: (skeleton, indices, weights, pose snapshot)."""
-        b = self.rig.binding
-        return (self.rig.skeleton, b.indices.copy(), b.weights.copy(), self.pose_snapshot())
+        """What a bind-mode edit changes: (skeleton, binding, pose snapshot). The binding
+        object itself is kept, so undo restores the weights bit for bit."""
+        return (self.rig.skeleton, self.rig.binding, self.pose_snapshot())
+
+    def make_rest_state(self, skeleton, indices, weights, pose=None):
+        """A state for :meth:`push_rest_edit` from new weights (validated here)."""
+        from .model.skinning import SkinBinding
+
+        binding = SkinBinding(self.rig.vertices, indices, weights, len(skeleton))
+        return (skeleton, binding, self.pose_snapshot() if pose is None else np.array(pose))
 
     def apply_rest_state(self, state):
-        skeleton, indices, weights, pose = state
+        skeleton, binding, pose = state
+        if len(skeleton) != len(self.skeleton) or binding.num_vertices != len(self.rig.vertices):
+            raise ValueError("expected a rest state of this rig's joints and vertices")
         self.rig.skeleton = skeleton
         self.pose.skeleton = skeleton
-        self.rig.bind(indices, weights)
+        self.rig.binding = binding
         self.pose.set_array(pose)
         self.emit("rest")
         self.emit("pose", joints=None)
 
     def push_rest_edit(self, label, before, after, execute=True):
-        """Record a rest/binding change (states from :meth:`rest_state`) as one undo step."""
+        """Record a rest/binding change (states from :meth:`rest_state` or
+        :meth:`make_rest_state`) as one undo step."""
         self.undo_stack.push(Command(label, lambda: self.apply_rest_state(after),
                                      lambda: self.apply_rest_state(before)), execute=execute)
 
     def set_weights(self, indices, weights, label="Set weights"):
+        """Replace the skin weights, (V, K) each, as one undo step."""
         before = self.rest_state()
-        after = (before[0], np.asarray(indices), np.asarray(weights, dtype=float), before[3])
-        self.push_rest_edit(label, before, after)
+        self.push_rest_edit(label, before, self.make_rest_state(before[0], indices, weights))
 
     # ------------------------------------------------------------------ undo
     def push(self, command, execute=True):

@@ -542,10 +542,11 @@ class MainWindow(QtWidgets.QMainWindow):
 
         def done(result):
             indices, weights = result
-            pose = before[3].copy()
+            pose = before[2].copy()
             delta = skeleton.rest_translation - before[0].rest_translation
             pose[:, :3] += delta  # keep the pose's offsets from rest
-            d.push_rest_edit(f"Move {name} (rest)", before, (skeleton, indices, weights, pose))
+            d.push_rest_edit(f"Move {name} (rest)", before,
+                             d.make_rest_state(skeleton, indices, weights, pose))
             self.status(f"Moved {name}'s rest position and re-bound the skin "
                         f"({len(vertices):,} vertices)")
 
