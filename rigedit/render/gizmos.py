@@ -6,6 +6,7 @@ Never imports Qt. The owner passes three callbacks, ``on_start(j)``, ``on_move(j
 """
 from __future__ import annotations
 
+import contextlib
 import traceback
 import warnings
 
@@ -58,6 +59,17 @@ def overlay_renderer(plotter):
     return ren
 
 
+@contextlib.contextmanager
+def _no_renders(iren):
+    """Each widget On()/Off() asks the interactor to render: batch them into none."""
+    was = iren.GetEnableRender()
+    iren.EnableRenderOff()
+    try:
+        yield
+    finally:
+        iren.SetEnableRender(was)
+
+
 def _sphere_widget_list(plotter):
     """The plotter's list of sphere widgets (closed with it); moved in pyvista 0.47."""
     helper = getattr(plotter, "widgets", None)
@@ -101,6 +113,11 @@ class JointGizmos:
         renderer = renderer or plotter.renderer
         iren = plotter.iren.interactor
         self.widgets = []
+        with _no_renders(iren):
+            self._create(iren, renderer, positions)
+
+    def _create(self, iren, renderer, positions):
+        plotter = self.plotter
         for j, p in enumerate(np.asarray(positions, dtype=float)):
             w = vtk.vtkSphereWidget()
             w.SetInteractor(iren)
@@ -170,8 +187,9 @@ class JointGizmos:
 
     def set_visible(self, visible):
         self.visible = bool(visible)
-        for w in self.widgets:
-            w.SetEnabled(self.visible)
+        with _no_renders(self.plotter.iren.interactor):
+            for w in self.widgets:
+                w.SetEnabled(self.visible)
 
     def display_position(self, j, renderer=None):
         """(x, y) display (pixel) coordinates of joint ``j``'s sphere centre."""
@@ -182,12 +200,14 @@ class JointGizmos:
         return x, y
 
     def remove(self):
-        for w in self.widgets:
-            w.Off()
-            w.RemoveAllObservers()
-            registry = _sphere_widget_list(self.plotter)
-            if w in registry:
-                registry.remove(w)
+        iren = self.plotter.iren.interactor if self.plotter.iren is not None else None
+        with (_no_renders(iren) if iren is not None else contextlib.nullcontext()):
+            for w in self.widgets:
+                w.Off()
+                w.RemoveAllObservers()
+                registry = _sphere_widget_list(self.plotter)
+                if w in registry:
+                    registry.remove(w)
         self.widgets = []
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..io.mesh import weld_vertices
 from ..io.skeleton_json import skeleton_from_heads
 from ..rig import Rig
 
@@ -92,4 +93,6 @@ def demo_rig():
             verts.append(v)
             faces.append(f + offset)
             offset += len(v)
-    return Rig(skeleton, np.vstack(verts), np.vstack(faces), name="demo creature", up="y")
+    # Tubes meet at joints: merge coincident vertices, as the mesh loader would on reading.
+    vertices, faces = weld_vertices(np.vstack(verts), np.vstack(faces))
+    return Rig(skeleton, vertices, faces, name="demo creature", up="y")
