@@ -266,6 +266,17 @@ class MainWindow(QtWidgets.QMainWindow):
         view.addSeparator()
         view.addAction(self.joint_dock.toggleViewAction())
         view.addAction(self.info_dock.toggleViewAction())
+        # --- timeline and video export (issue 5) ---
+        from .record_dialog import RecordDialog
+        from .timeline import TimelineDock
+        self.timeline = TimelineDock(self)
+        self.addDockWidget(QtCore.Qt.BottomDockWidgetArea, self.timeline)
+        view.addAction(self.timeline.toggleViewAction())
+        self.export_video_action = self._action("Export &video...", lambda: RecordDialog.run(self))
+        file_menu = self.menuBar().actions()[0].menu()
+        file_menu.insertAction(next(a for a in file_menu.actions() if a.text().startswith(
+            "Save screenshot")), self.export_video_action)
+        # --- end timeline ---
 
     def _build_status_bar(self):
         sb = self.statusBar()
@@ -631,6 +642,12 @@ class MainWindow(QtWidgets.QMainWindow):
         box.setAttribute(QtCore.Qt.WA_DeleteOnClose)
         box.open()
         self._last_dialog = box
+
+    def record_video(self, path, fps=30, duration=None, size=(1280, 720), **options):
+        """Record the current clip to ``path`` (MP4 or GIF) off-screen, as File > Export video
+        does; see :func:`rigedit.ui.record_dialog.record_video`. Returns the frame count."""
+        from .record_dialog import record_video  # issue 5
+        return record_video(self, path, fps=fps, duration=duration, size=size, **options)
 
     # ================================================================== screenshot, close
     def screenshot(self, path=None):

@@ -1,0 +1,181 @@
+"""File > Export video: the settings dialog and the recording run with a progress dialog.
+
+The recording itself is :func:`rigedit.render.recorder.record_clip` (the same code as the
+``rigedit render`` command): its own off-screen plotter, a copy of the clip, exact times
+``start + i / fps``. It runs on the main thread (VTK must) in steps: the progress callback
+processes Qt events between frames, so the progress dialog repaints and its Cancel button
+works; the dialog is modal, so the document cannot change under the recording.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from PyQt5 import QtCore, QtWidgets
+
+from ..errors import RigFileError
+from ..render.recorder import RecordingCancelled, camera_state, record_clip
+
+__all__ = ["RecordDialog", "record_video"]
+
+
+def record_video(window, path, fps=30, duration=None, size=(1280, 720), start=0.0,
+                 camera="view", orbit=360.0, clip=None, follow_root=False, progress=True,
+                 **options):
+    """Record the window's current clip (or ``clip``, a name) to ``path``.
+
+    Parameters
+    ----------
+    window : MainWindow
+    path : str or Path
+        ``.mp4`` or ``.gif``.
+    fps : float
+    duration : float, optional
+        Seconds from ``start``; up to the clip's end when omitted.
+    size : (int, int)
+    start : float
+        Clip time of the first frame.
+    camera : {"view", "orbit"} or dict
+        ``"view"`` copies the editor's current camera; ``"orbit"`` starts from it and turns
+        ``orbit`` degrees about the vertical axis over the recording; a dict is used as is
+        (see :func:`~rigedit.render.recorder.camera_state`).
+    follow_root : bool
+        Move the camera with the root's horizontal motion.
+    progress : bool
+        Show a progress dialog with Cancel (processes Qt events between frames).
+
+    Returns
+    -------
+    frames : int
+        Frames written, or 0 when cancelled (no file is then left behind).
+    """
+    doc = window.document
+    name = clip if clip is not None else doc.current_clip
+    clip_obj = doc.clips.get(name) if name is not None else None
+    if duration is None:
+        end = clip_obj.duration if clip_obj is not None and clip_obj.duration > 0 else 1.0
+        duration = max(end - start, 1.0 / fps)
+    cam = camera if isinstance(camera, dict) else camera_state(window.plotter.camera)
+    turn = float(orbit) if camera == "orbit" else 0.0
+    dialog = None
+    callback = None
+    if progress:
+        total = max(1, int(round(duration * fps)))
+        dialog = QtWidgets.QProgressDialog(f"Recording {Path(path).name}...", "Cancel", 0, total,
+                                           window)
+        dialog.setWindowTitle("Export video")
+        dialog.setWindowModality(QtCore.Qt.WindowModal)
+        dialog.setMinimumDuration(0)
+        dialog.setValue(0)
+
+        def callback(done, total_):
+            dialog.setMaximum(total_)
+            dialog.setValue(done)
+            QtWidgets.QApplication.processEvents()
+            return not dialog.wasCanceled()
+    try:
+        n = record_clip(doc.rig, clip_obj, path, fps=fps, duration=duration, size=size,
+                        start=start, camera=cam, orbit=turn, follow_root=follow_root,
+                        progress=callback, **options)
+    except RecordingCancelled:
+        window.status("Export video: cancelled")
+        return 0
+    finally:
+        if dialog is not None:
+            dialog.reset()
+            dialog.deleteLater()
+        # the interactive view keeps its own plotter; repaint it in case the window was covered
+        window.plotter.update()
+    window.status(f"Recorded {n} frames to {path}")
+    return n
+
+
+class RecordDialog(QtWidgets.QDialog):
+    """Export settings: file, size, frame rate, time range, camera."""
+
+    def __init__(self, window):
+        super().__init__(window)
+        self.window_ = window
+        self.setWindowTitle("Export video")
+        doc = window.document
+        clip = doc.clips.get(doc.current_clip) if doc.current_clip else None
+        end = clip.duration if clip is not None and clip.duration > 0 else 1.0
+        form = QtWidgets.QFormLayout(self)
+        self.path_edit = QtWidgets.QLineEdit(str(Path.cwd() / f"{clip.name if clip else 'rest'}.mp4"))
+        browse = QtWidgets.QPushButton("Browse...")
+        browse.clicked.connect(self._browse)
+        row = QtWidgets.QHBoxLayout()
+        row.addWidget(self.path_edit, 1)
+        row.addWidget(browse)
+        form.addRow("File (MP4 or GIF)", row)
+        self.width_spin, self.height_spin = QtWidgets.QSpinBox(), QtWidgets.QSpinBox()
+        for s, v in ((self.width_spin, 1280), (self.height_spin, 720)):
+            s.setRange(16, 7680)
+            s.setSingleStep(2)
+            s.setValue(v)
+        size = QtWidgets.QHBoxLayout()
+        size.addWidget(self.width_spin)
+        size.addWidget(QtWidgets.QLabel("x"))
+        size.addWidget(self.height_spin)
+        form.addRow("Size (pixels)", size)
+        self.fps_spin = QtWidgets.QSpinBox()
+        self.fps_spin.setRange(1, 120)
+        self.fps_spin.setValue(30)
+        form.addRow("Frame rate", self.fps_spin)
+        self.start_spin, self.end_spin = QtWidgets.QDoubleSpinBox(), QtWidgets.QDoubleSpinBox()
+        for s, v in ((self.start_spin, 0.0), (self.end_spin, end)):
+            s.setRange(0.0, 3600.0)
+            s.setDecimals(3)
+            s.setSuffix(" s")
+            s.setValue(v)
+        rng = QtWidgets.QHBoxLayout()
+        rng.addWidget(self.start_spin)
+        rng.addWidget(QtWidgets.QLabel("to"))
+        rng.addWidget(self.end_spin)
+        form.addRow(f"Time range ({clip.name if clip else 'no clip'})", rng)
+        self.view_radio = QtWidgets.QRadioButton("Current view")
+        self.orbit_radio = QtWidgets.QRadioButton("Orbit")
+        self.view_radio.setChecked(True)
+        self.orbit_spin = QtWidgets.QDoubleSpinBox()
+        self.orbit_spin.setRange(-1440, 1440)
+        self.orbit_spin.setValue(360)
+        self.orbit_spin.setSuffix(" °")
+        cam = QtWidgets.QHBoxLayout()
+        for w in (self.view_radio, self.orbit_radio, self.orbit_spin):
+            cam.addWidget(w)
+        form.addRow("Camera", cam)
+        self.follow_box = QtWidgets.QCheckBox("Follow the root's horizontal motion")
+        form.addRow("", self.follow_box)
+        buttons = QtWidgets.QDialogButtonBox(QtWidgets.QDialogButtonBox.Ok
+                                             | QtWidgets.QDialogButtonBox.Cancel)
+        buttons.button(QtWidgets.QDialogButtonBox.Ok).setText("Record")
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        form.addRow(buttons)
+
+    def _browse(self):
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self, "Export video", self.path_edit.text(), "Video (*.mp4 *.gif)")
+        if path:
+            self.path_edit.setText(path)
+
+    def settings(self):
+        """Keyword arguments for :func:`record_video`."""
+        start, end = self.start_spin.value(), self.end_spin.value()
+        return {"path": self.path_edit.text().strip(), "fps": self.fps_spin.value(),
+                "size": (self.width_spin.value(), self.height_spin.value()), "start": start,
+                "duration": max(end - start, 1.0 / self.fps_spin.value()),
+                "camera": "orbit" if self.orbit_radio.isChecked() else "view",
+                "orbit": self.orbit_spin.value(), "follow_root": self.follow_box.isChecked()}
+
+    @staticmethod
+    def run(window):
+        """Show the dialog and record on OK; errors become one message."""
+        dialog = RecordDialog(window)
+        if dialog.exec_() != QtWidgets.QDialog.Accepted:
+            return 0
+        kwargs = dialog.settings()
+        try:
+            return record_video(window, kwargs.pop("path"), **kwargs)
+        except (RigFileError, ValueError, OSError) as exc:
+            window.error("Export video", str(exc))
+            return 0
