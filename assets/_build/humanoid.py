@@ -15,7 +15,7 @@ def joints():
          ("Spine1", "Spine", (0, 1.20, -0.005), None, True),
          ("Spine2", "Spine1", (0, 1.32, -0.01), None, True),
          ("Neck", "Spine2", (0, 1.50, -0.01), None, True),
-         ("Head", "Neck", (0, 1.60, 0.0), (0, 1.78, 0.01), True)]
+         ("Head", "Neck", (0, 1.58, 0.0), (0, 1.76, 0.01), True)]
     for s, x in _SIDE:
         J += [(f"{s}Shoulder", "Spine2", (0.03 * x, 1.44, -0.01), None, True),
               (f"{s}Arm", f"{s}Shoulder", (0.17 * x, 1.45, -0.02), None, True),
@@ -49,13 +49,13 @@ def prims(H):
     e("Spine1", (0, 1.22, 0.0), (0.15, 0.12, 0.105), blend=B)
     e("Spine2", (0, 1.35, -0.01), (0.17, 0.11, 0.11), blend=B)
     e("Spine2", (0, 1.30, 0.045), (0.13, 0.08, 0.07), blend=B)   # chest
-    c("Neck", (0, 1.44, -0.015), (0, 1.63, 0.0), 0.055, 0.048, blend=0.04)
-    e("Head", (0, 1.70, 0.01), (0.078, 0.105, 0.098), blend=0.04)
-    e("Head", (0, 1.645, 0.04), (0.062, 0.06, 0.07), blend=0.04)      # jaw
-    e("Head", (0, 1.685, 0.102), (0.014, 0.024, 0.02), blend=0.015)   # nose
+    c("Neck", (0, 1.44, -0.015), (0, 1.61, 0.0), 0.055, 0.048, blend=0.04)
+    e("Head", (0, 1.675, 0.01), (0.078, 0.10, 0.098), blend=0.04)
+    e("Head", (0, 1.62, 0.04), (0.062, 0.06, 0.07), blend=0.04)      # jaw
+    e("Head", (0, 1.662, 0.10), (0.014, 0.024, 0.02), blend=0.015)   # nose
     for s, x in _SIDE:
         e("Hips", (0.07 * x, 0.90, -0.055), (0.085, 0.09, 0.07), blend=B)   # buttock
-        e("Head", (0.08 * x, 1.69, 0.0), (0.012, 0.028, 0.018), blend=0.012)  # ear
+        e("Head", (0.08 * x, 1.667, 0.0), (0.012, 0.028, 0.018), blend=0.012)  # ear
         sh, arm, fa, hand = (H[f"{s}{n}"] for n in ("Shoulder", "Arm", "ForeArm", "Hand"))
         c(f"{s}Shoulder", sh + (0, -0.02, 0), arm, 0.06, 0.055, blend=0.05)
         c(f"{s}Arm", arm, fa, 0.052, 0.04, blend=0.04)

@@ -52,9 +52,9 @@ class Walker:
         p = (t / self.T - self.phase[s]) % 1.0
         if sw == 0.0:
             theta = self.heel * _smooth((p - 0.6 * self.duty) / (0.4 * self.duty))
-            return dz, ly, theta, 0.0, 0.0
+            return dz, ly, theta, 1.0, 0.0
         theta = self.heel * (1 - _smooth(sw / 0.7)) - 0.25 * np.sin(np.pi * sw) ** 2
-        toe = 1.0 - _smooth(sw / 0.3)   # the toe unrolls from flat to straight
+        toe = 1.0 - _smooth((sw - 0.1) / 0.3)   # the toe unrolls from flat to straight
         fold = np.sin(np.pi * sw) ** 2
         return dz, ly, theta, toe, fold
 
@@ -67,7 +67,11 @@ class Walker:
         M = sk.forward(pose.local_matrices())
         for s, chain in self.legs.items():
             dz, ly, theta, toe, fold = self.foot(s, t)
-            ball = self.ball[s] + complex(ly, dz)
+            # Lift the ball by the deepest dip of the toe tip and heel below it so the
+            # turning foot never scrapes the ground in the swing.
+            dip = max(0.0, -0.09 * np.sin(-theta * (1 - toe)), -0.17 * np.sin(theta)) \
+                if fold > 0 else 0.0
+            ball = self.ball[s] + complex(ly + dip, dz)
             target = ball + np.exp(1j * theta) * self.ankle_off[s]
             alphas, miss = chain.solve(yz(M[chain.idx[0], :3, 3]), target, fold)
             self.max_miss = max(self.max_miss, miss)

@@ -27,6 +27,12 @@ class Locomotion:
                 sk, [f"fore_upper_{s}", f"fore_lower_{s}", f"fore_cannon_{s}", f"fore_hoof_{s}"],
                 stance=(-1.0, 0.05), fold=(-0.25, 1.1), s_range=(-1.0, 1.2))
         self.rest_end = {k: yz(sk.bind_matrices[c.idx[-1], :3, 3]) for k, c in self.legs.items()}
+        self.sole = {}
+        for k, c in self.legs.items():
+            j = c.idx[-1]
+            toe = yz(sk.tails[j]) - yz(sk.bind_matrices[j, :3, 3])
+            # Points of the sole (front, middle, heel of the hoof's bottom), fetlock-relative.
+            self.sole[k] = toe + np.array([-0.03 + 0.045j, -0.03 + 0.0j, -0.03 - 0.045j])
         self.max_miss = 0.0
 
     def __call__(self, t):
@@ -49,15 +55,28 @@ class Locomotion:
         for leg, chain in self.legs.items():
             dz, ly, s = feet[leg]
             f = self.fold * np.sin(np.pi * s) ** 2 if s > 0 else 0.0
-            target = self.rest_end[leg] + complex(ly, dz)
-            alphas, miss = chain.solve(yz(M[chain.idx[0], :3, 3]), target, f)
+            curl = self.curl[0] if leg.startswith("fore") else self.curl[1]
+            w = f / max(self.fold, 1e-9)
+            top = yz(M[chain.idx[0], :3, 3])
+            parent = x_angle(M[chain.parent])
+            # Turning the hoof lowers its toe or its heel: lift the fetlock by the deepest
+            # dip of the hoof's sole points so a hoof that folds in the swing never goes
+            # below the ground (a few passes: the hoof's turn depends on the cannon's).
+            raise_by = 0.0
+            for _ in range(3):
+                target = self.rest_end[leg] + complex(ly + raise_by, dz)
+                alphas, miss = chain.solve(top, target, f)
+                hoof_world = w * (alphas[-1] + curl)
+                sole = self.sole[leg]
+                dip = float(np.max(sole.real - (sole * np.exp(1j * hoof_world)).real))
+                if dip <= raise_by + 1e-4:
+                    break
+                raise_by = dip
             self.max_miss = max(self.max_miss, miss)
-            prev = x_angle(M[chain.parent])
+            prev = parent
             for j, a in zip(chain.idx[:-1], alphas):
                 pose.rotation[j] = qx(a - prev)
                 prev = a
-            curl = self.curl[0] if leg.startswith("fore") else self.curl[1]
-            hoof_world = (f / max(self.fold, 1e-9)) * (alphas[-1] + curl)
             pose.rotation[chain.idx[-1]] = qx(hoof_world - alphas[-1])
         return pose
 
