@@ -1,0 +1,228 @@
+"""The timeline dock on a real window under Xvfb: playback in real time with skip-ahead,
+scrubbing poses the mesh, keys inserted / moved / deleted / pasted with undo, auto-key, clip
+management, interpolation, video export from the editor."""
+import time
+
+import imageio.v3 as iio
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+pytest.importorskip("pytestqt")
+pytestmark = [pytest.mark.ui, pytest.mark.filterwarnings("error::RuntimeWarning")]
+
+from PyQt5 import QtCore, QtGui, QtWidgets  # noqa: E402
+
+from rigedit.animation import Clip, Track  # noqa: E402
+
+
+def _rig():
+    from rigedit.ui.fallback import demo_rig
+
+    rig = demo_rig()   # small: the UI tests stay fast
+    sk = rig.skeleton
+    j = sk.index["neck"]
+    rest = Rotation.from_quat(sk.rest_rotation[j])
+    q = [(rest * Rotation.from_euler("x", a, degrees=True)).as_quat() for a in (0, 50, 0)]
+    rig.clips["nod"] = Clip("nod", sk, {("neck", "rotation"): Track("rotation", [0, 0.5, 1], q)},
+                            duration=1.0)
+    return rig
+
+
+@pytest.fixture
+def window(qtbot):
+    from threadpoolctl import threadpool_limits
+
+    from rigedit.ui import MainWindow
+
+    with threadpool_limits(1):
+        w = MainWindow(_rig())
+        qtbot.addWidget(w)
+        w.resize(1000, 700)
+        w.show()
+        qtbot.waitExposed(w)
+        yield w
+        w.close()
+
+
+def _mouse(widget, kind, x, y):
+    types = {"press": QtCore.QEvent.MouseButtonPress, "move": QtCore.QEvent.MouseMove,
+             "release": QtCore.QEvent.MouseButtonRelease}
+    buttons = QtCore.Qt.NoButton if kind == "release" else QtCore.Qt.LeftButton
+    ev = QtGui.QMouseEvent(types[kind], QtCore.QPointF(x, y), QtCore.Qt.LeftButton, buttons,
+                           QtCore.Qt.NoModifier)
+    QtWidgets.QApplication.sendEvent(widget, ev)
+
+
+def _row_y(ruler, row):
+    return ruler.row_y(row) + 8
+
+
+def test_play_advances_in_real_time_and_pause_freezes(window, qtbot):
+    tl = window.timeline
+    assert tl.time == 0.0
+    tl.play()
+    assert tl.playing
+    qtbot.waitUntil(lambda: tl.time > 0.15, timeout=3000)
+    tl.pause()
+    frozen = tl.time
+    qtbot.wait(100)
+    assert tl.time == frozen and not tl.playing
+
+
+def test_a_slow_frame_skips_ahead(window, qtbot):
+    tl = window.timeline
+    tl.set_loop(False)
+    tl.play()
+    time.sleep(0.4)                      # the UI is blocked: no tick for 0.4 s
+    qtbot.wait(40)                       # the next tick jumps to wall time, not + 1 frame
+    assert tl.time >= 0.4
+    tl.pause()
+
+
+def test_one_shot_playback_stops_at_the_end(window, qtbot):
+    tl = window.timeline
+    tl.set_loop(False)
+    tl.set_speed(4.0)
+    tl.play()
+    qtbot.waitUntil(lambda: not tl.playing, timeout=3000)
+    assert tl.time == pytest.approx(1.0)
+
+
+def test_scrubbing_with_the_mouse_poses_the_mesh(window, qtbot):
+    tl, ruler = window.timeline, window.timeline.ruler
+    before = np.array(window.scene.mesh.points)
+    gizmo_before = window.gizmos.center(window.document.skeleton.index["head"])
+    _mouse(ruler, "press", ruler.x_of(0.1), 5)
+    _mouse(ruler, "move", ruler.x_of(0.5), 5)
+    _mouse(ruler, "release", ruler.x_of(0.5), 5)
+    assert tl.time == pytest.approx(0.5, abs=1 / 30)
+    moved = np.abs(np.array(window.scene.mesh.points) - before).max()
+    assert moved > 0.05
+    # the gizmos follow the pose
+    assert np.linalg.norm(window.gizmos.center(window.document.skeleton.index["head"])
+                          - gizmo_before) > 0.05
+
+
+def test_insert_key_with_k_then_undo(window, qtbot):
+    tl, doc = window.timeline, window.document
+    doc.select("tail")
+    tl.set_time(0.25)
+    doc.set_joint_euler("tail", [0, 30, 0])
+    n = len(doc.undo_stack)
+    window.activateWindow()
+    qtbot.waitUntil(lambda: QtWidgets.QApplication.activeWindow() is window, timeout=2000)
+    qtbot.keyClick(window.plotter, QtCore.Qt.Key_K)
+    clip = tl.clip
+    assert ("tail", "rotation") in clip.tracks
+    assert clip.key_times("tail").tolist() == [0.25]
+    assert len(doc.undo_stack) == n + 1
+    assert clip.sample(0.25).allclose(doc.pose)
+    doc.undo()
+    assert ("tail", "rotation") not in clip.tracks
+
+
+def test_key_all_joints_keys_every_joint(window):
+    tl, doc = window.timeline, window.document
+    tl.set_time(0.75)
+    tl.insert_key(all_joints=True)
+    keyed = {j for (j, c) in tl.clip.tracks if c == "rotation" and 0.75 in tl.clip.key_times(j)}
+    assert keyed == set(doc.skeleton.names)
+
+
+def test_drag_a_key_in_the_ruler_moves_it_and_undo_restores(window):
+    tl, doc, ruler = window.timeline, window.document, window.timeline.ruler
+    doc.select("neck")
+    y = _row_y(ruler, 1)                                  # the selected joint's row
+    assert ruler.key_at(ruler.x_of(0.5), y) == (0.5, False)
+    _mouse(ruler, "press", ruler.x_of(0.5), y)
+    _mouse(ruler, "move", ruler.x_of(0.6), y)
+    _mouse(ruler, "move", ruler.x_of(0.7), y)
+    _mouse(ruler, "release", ruler.x_of(0.7), y)
+    np.testing.assert_allclose(tl.clip.key_times("neck"), [0, 0.7, 1], atol=1e-9)
+    assert tl.time == pytest.approx(0.7)
+    assert doc.undo_stack.undo_label.startswith("Move key")
+    doc.undo()
+    np.testing.assert_allclose(tl.clip.key_times("neck"), [0, 0.5, 1])
+
+
+def test_delete_key_and_undo_restore_the_pose(window):
+    tl, doc = window.timeline, window.document
+    tl.set_time(0.5)
+    posed = np.array(window.scene.mesh.points)
+    tl.delete_key(all_joints=True)
+    np.testing.assert_allclose(tl.clip.key_times("neck"), [0, 1])
+    # the neck now stays at rest between two rest keys: the mesh changed
+    assert np.abs(np.array(window.scene.mesh.points) - posed).max() > 0.05
+    doc.undo()
+    np.testing.assert_allclose(np.array(window.scene.mesh.points), posed, atol=1e-5)
+
+
+def test_copy_paste_keys(window):
+    tl, doc = window.timeline, window.document
+    doc.select("neck")
+    tl.set_time(0.5)
+    tl.copy_keys()
+    tl.set_time(0.9)
+    tl.paste_keys()
+    assert tl.clip.sample(0.9).allclose(tl.clip.sample(0.5))
+    assert doc.undo_stack.undo_label.startswith("Paste")
+
+
+def test_auto_key_writes_keys_when_posing(window):
+    tl, doc = window.timeline, window.document
+    tl.set_auto_key(True)
+    tl.set_time(0.2)
+    doc.set_joint_euler("tail", [0, 0, 25])
+    assert 0.2 in tl.clip.key_times("tail")
+    assert tl.clip.sample(0.2).allclose(doc.pose)
+    assert doc.undo_stack.undo_label.startswith("Auto-key")
+    doc.undo()                                          # the key goes first
+    assert len(tl.clip.key_times("tail")) == 0
+    tl.set_auto_key(False)
+    doc.set_joint_euler("tail", [0, 0, 10])
+    assert len(tl.clip.key_times("tail")) == 0
+
+
+def test_interpolation_per_track_with_undo(window):
+    tl, doc = window.timeline, window.document
+    doc.select("neck")
+    tl.set_interpolation("catmull_rom", "rotation")
+    assert tl.clip.tracks[("neck", "rotation")].interpolation == "catmull_rom"
+    assert tl.rot_combo.currentText() == "catmull_rom"
+    doc.undo()
+    assert tl.clip.tracks[("neck", "rotation")].interpolation == "slerp"
+
+
+def test_clip_new_rename_duplicate_delete_with_undo(window):
+    tl, doc = window.timeline, window.document
+    name = tl.new_clip("walk", duration=3.0)
+    assert doc.current_clip == name == "walk" and tl.clip_combo.currentText() == "walk"
+    assert tl.duration_spin.value() == 3.0
+    tl.rename_clip("stride")
+    assert "stride" in doc.clips and "walk" not in doc.clips and tl.clip.name == "stride"
+    copy = tl.duplicate_clip()
+    assert copy == "stride copy" and doc.clips[copy] is not doc.clips["stride"]
+    tl.delete_clip()
+    assert copy not in doc.clips
+    for _ in range(3):
+        doc.undo()
+    assert set(doc.clips) == {"nod", "walk"} and doc.clips["walk"].name == "walk"
+    tl.set_duration(2.0)
+    assert doc.clips["walk"].duration == 2.0
+    doc.undo()
+    assert doc.clips["walk"].duration == 3.0
+
+
+def test_record_video_from_the_editor(window, tmp_path, qtbot):
+    path = tmp_path / "nod.mp4"
+    n = window.record_video(path, fps=10, size=(192, 144), progress=True)
+    assert n == 10
+    frames = np.stack(list(iio.imiter(path)))
+    assert frames.shape == (10, 144, 192, 3)
+    assert np.abs(frames[5].astype(int) - frames[0].astype(int)).mean() > 0.5
+    # the editor is still usable: scrubbing still poses the interactive mesh
+    before = np.array(window.scene.mesh.points)
+    window.timeline.set_time(0.5)
+    assert np.abs(np.array(window.scene.mesh.points) - before).max() > 0.05
+    assert window.export_video_action.isEnabled()
