@@ -101,7 +101,29 @@ class MainWindow(QtWidgets.QMainWindow):
     def _build_view(self):
         self.plotter = QtInteractor(self, multi_samples=0, auto_update=False)
         self.plotter.set_background(BACKGROUND[0], top=BACKGROUND[1])
+        self._route_renders_through_qt()
         self.setCentralWidget(self.plotter)
+
+    def _route_renders_through_qt(self):
+        """Make VTK's own render requests (a sphere widget after each mouse move, the camera
+        style) schedule one Qt paint instead of rendering now: the widget's paint renders
+        again anyway, and two renders per mouse move halved the drag rate (DESIGN pitfalls).
+
+        ``vtkRenderWindowInteractor.Render`` always fires ``RenderEvent``, even with
+        rendering disabled, so that such a redirect is possible.
+        """
+        plotter = self.plotter
+        iren = plotter.iren.interactor
+        rw = plotter.render_window
+        iren.EnableRenderOff()
+
+        def on_render_request(_obj, _event):
+            if getattr(plotter, "_in_paint", True):  # inside paintGL: render for real
+                rw.Render()
+            else:
+                plotter.update()
+
+        iren.AddObserver("RenderEvent", on_render_request)
 
     def _action(self, text, slot, shortcut=None, checkable=False, checked=False, tip=None):
         act = QtWidgets.QAction(text, self)

@@ -1,0 +1,136 @@
+#!/usr/bin/env python3
+"""Speed of dragging a joint in the editor.
+
+1. Model side of one drag step on the default character, no rendering: IK (chain of 2)
+   from the pose at drag start, forward kinematics, skinning palette, linear blend skinning.
+   Also the same plus the copy into the VTK mesh and bones (``scene.update_from_matrices``).
+2. Frames per second of a real drag in the window under Xvfb: mouse press on a joint sphere,
+   N mouse moves, release, through the VTK interactor (each move = one IK solve, skinning,
+   in-place point update and one render, counted with a render-window observer).
+
+Run: ``xvfb-run -a .venv/bin/python benchmarks/bench_drag.py [RIG] [--size 1280x720]``.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+import warnings
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+
+def _limb_joint(sk):
+    for name in ("fore_cannon_L", "hind_cannon_L", "front_foot_L"):
+        if name in sk.index:
+            return sk.index[name]
+    return len(sk) - 1
+
+
+def model_step(rig, steps=300):
+    from rigedit.model.ik import drag_joint
+
+    sk = rig.skeleton
+    j = _limb_joint(sk)
+    start = rig.rest_pose()
+    snap = start.as_array()
+    work = start.copy()
+    head = rig.joint_matrices(start)[j, :3, 3]
+    h = rig.height()
+    targets = head + 0.15 * h * np.stack([np.sin(np.linspace(0, 6, steps)),
+                                          np.cos(np.linspace(0, 6, steps)) - 1,
+                                          np.zeros(steps)], axis=1)
+    times = []
+    for t in targets:
+        t0 = time.perf_counter()
+        work.set_array(snap)
+        drag_joint(sk, work, j, t, chain_length=2, fk=rig.joint_matrices)
+        model = rig.joint_matrices(work)
+        rig.binding.skin(np.matmul(model, sk.inverse_bind_matrices))
+        times.append(time.perf_counter() - t0)
+    ik = []
+    for t in targets[:100]:
+        t0 = time.perf_counter()
+        work.set_array(snap)
+        drag_joint(sk, work, j, t, chain_length=2, fk=rig.joint_matrices)
+        ik.append(time.perf_counter() - t0)
+    return np.array(times) * 1e3, np.array(ik) * 1e3
+
+
+def window_drag(rig, size, moves=120):
+    from PyQt5 import QtWidgets
+
+    from rigedit.ui import MainWindow
+
+    app = QtWidgets.QApplication.instance() or QtWidgets.QApplication([])
+    w = MainWindow(rig)
+    w.resize(*size)
+    w.show()
+    for _ in range(10):
+        app.processEvents()
+    w.view("side")
+    w.plotter.render()
+    app.processEvents()
+    j = _limb_joint(rig.skeleton)
+    renders = [0]
+    w.plotter.render_window.AddObserver("EndEvent", lambda *a: renders.__setitem__(0, renders[0] + 1))
+    iren = w.plotter.iren.interactor
+    x, y = w.gizmos.display_position(j)
+    x, y = int(round(x)), int(round(y))
+    iren.SetEventInformation(x, y)
+    iren.InvokeEvent("LeftButtonPressEvent")
+    assert w.gizmos.active == j, "the press missed the sphere"
+    renders[0] = 0
+    t0 = time.perf_counter()
+    for k in range(moves):
+        a = 2 * np.pi * k / moves
+        iren.SetEventInformation(x + int(60 * np.sin(a)), y + int(40 * (1 - np.cos(a))))
+        iren.InvokeEvent("MouseMoveEvent")
+        app.processEvents()
+    elapsed = time.perf_counter() - t0
+    n_renders = renders[0]
+    iren.InvokeEvent("LeftButtonReleaseEvent")
+    app.processEvents()
+    # Scene update alone (points into VTK), for the breakdown.
+    model = rig.joint_matrices(w.document.pose)
+    t1 = time.perf_counter()
+    for _ in range(50):
+        w.scene.update_from_matrices(model)
+    scene_ms = (time.perf_counter() - t1) / 50 * 1e3
+    steps = len(w.document.undo_stack)
+    w.close()
+    return moves / elapsed, n_renders / moves, scene_ms, steps
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("rig", nargs="?")
+    parser.add_argument("--size", default="1280x720", help="window size")
+    parser.add_argument("--no-window", action="store_true")
+    args = parser.parse_args()
+    import rigedit
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rig = rigedit.load_rig(args.rig)
+    print(f"rig: {rig.name}, {len(rig.vertices):,} vertices, {len(rig.faces):,} faces, "
+          f"{len(rig.skeleton)} joints")
+    with threadpool_limits(1):
+        total, ik = model_step(rig)
+        print(f"model drag step (IK chain 2 + FK + skinning): median {np.median(total):.2f} ms, "
+              f"p95 {np.percentile(total, 95):.2f} ms  (IK alone {np.median(ik):.2f} ms)")
+        if not args.no_window:
+            size = tuple(int(v) for v in args.size.split("x"))
+            fps, per_move, scene_ms, steps = window_drag(rig, size)
+            print(f"scene update (points + bones into VTK): {scene_ms:.2f} ms")
+            print(f"window drag at {args.size} under {os.environ.get('DISPLAY', '?')}: "
+                  f"{fps:.1f} frames/s, {per_move:.2f} renders per mouse move, "
+                  f"{steps} undo step(s)")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
