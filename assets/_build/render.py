@@ -20,6 +20,9 @@ def render_frames(verts_list, faces, views, size=(320, 260), color="tan", extra=
     radius = np.linalg.norm(hi - lo) / 2
     pl = pv.Plotter(off_screen=True, window_size=size)
     pl.set_background("white")
+    # The default light kit leaves surfaces that face down-forward (a shin in the swing) dark;
+    # a dim headlight keeps every visible surface readable.
+    pl.add_light(pv.Light(light_type="headlight", intensity=0.45))
     pl.add_mesh(mesh, color=color, smooth_shading=True, specular=0.3)
     floor = pv.Plane(center=(centre[0], 0, centre[2]), direction=(0, 1, 0),
                      i_size=(hi[0] - lo[0]) + 2, j_size=(hi[2] - lo[2]) + 2, i_resolution=20,
