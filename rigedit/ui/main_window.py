@@ -336,7 +336,7 @@ class MainWindow(QtWidgets.QMainWindow):
                                   self._drag_start, self._drag_move, self._drag_end,
                                   renderer=self.overlay)
         self.gizmos.set_visible(self.gizmos_action.isChecked())
-        self.axes = AxisHandles(self.plotter, 6 * self.radius, renderer=self.overlay)
+        self.axes = AxisHandles(self.plotter, 10 * self.radius, renderer=self.overlay)
         self.axes.set_axis(self.axis)
         self.joint_panel.set_skeleton(rig.skeleton)
         self.info_panel.show_rig(rig)
