@@ -377,11 +377,11 @@ def mirror_pose(pose, mirror, names, axis, source="L"):
     """Copy one side's local transforms onto the other, reflected across the plane normal to
     model ``axis`` (in place).
 
-    A rotation reflected across the plane whose normal is ``axis`` keeps its component along
-    ``axis`` of the quaternion's vector part sign... concretely, for a reflection across x:
-    (x, y, z, w) -> (x, -y, -z, w); translations flip their ``axis`` coordinate. This is exact
-    for joints whose rest frames are themselves mirror images aligned with the model axes (the
-    usual case, and the case of axis-aligned frames from head positions).
+    Reflecting across the plane normal to x maps a rotation quaternion (x, y, z, w) to
+    (x, -y, -z, w) (the component along the normal keeps its sign, the others flip) and a
+    translation's x to -x. This is exact when the two sides' parent frames are mirror images
+    aligned with the model axes: the usual case, and always so for frames built from head
+    positions (elk skeletons, the bundled characters).
     """
     flip = np.ones(3)
     flip[axis] = -1.0
