@@ -154,3 +154,20 @@ def test_atomic_write_keeps_the_old_file_on_failure(tmp_path):
             raise RuntimeError("crash mid-write")
     assert p.read_text() == "old"
     assert [x.name for x in tmp_path.iterdir()] == ["keep.json"]
+
+
+def test_round_trip_keeps_coincident_vertices(tmp_path):
+    """A mesh with two vertices at one position (split normals) keeps its vertex count, so
+    its weights still fit after save and load."""
+    rig = cylinder_rig(with_clip=False)
+    from rigedit.rig import Rig
+
+    dup = np.vstack([rig.vertices, rig.vertices[:1]])
+    faces = rig.faces.copy()
+    first = np.flatnonzero((faces == 0).any(axis=1))[0]
+    faces[first][faces[first] == 0] = len(dup) - 1
+    twin = Rig(rig.skeleton, dup, faces, name="twin")
+    save_rig_folder(tmp_path / "t", twin)
+    back = load_rig_folder(tmp_path / "t")
+    assert len(back.vertices) == len(dup)
+    assert np.allclose(back.binding.dense(), twin.binding.dense(), atol=1e-6)

@@ -27,7 +27,7 @@ from .clip_json import load_clip, save_clip
 from .jsonfile import read_json
 from .mesh import MESH_SUFFIXES, load_mesh, save_obj
 from .skeleton_json import load_skeleton, save_skeleton
-from .weights_npz import load_weights, save_weights
+from .weights_npz import load_weights, save_weights, weights_vertex_count
 
 __all__ = ["load_rig_folder", "save_rig_folder", "find_rig_files", "WeightsComputedWarning"]
 
@@ -88,14 +88,24 @@ def load_rig_folder(folder, weights_method="idw"):
     folder = Path(folder)
     files = find_rig_files(folder)
     skeleton, meta = load_skeleton(files["skeleton"])
-    parts = [load_mesh(p) for p in files["meshes"]]
-    offsets = np.cumsum([0] + [len(v) for v, _ in parts[:-1]])
-    vertices = np.concatenate([v for v, _ in parts])
-    faces = np.concatenate([f + o for (_, f), o in zip(parts, offsets)])
+
+    def read_mesh(weld):
+        parts = [load_mesh(p, weld=weld) for p in files["meshes"]]
+        offsets = np.cumsum([0] + [len(v) for v, _ in parts[:-1]])
+        return (np.concatenate([v for v, _ in parts]),
+                np.concatenate([f + o for (_, f), o in zip(parts, offsets)]))
+
+    # A weights file fixes the vertex order: keep the mesh's vertices as they are when the
+    # weights fit them (a saved rig whose mesh has coincident vertices, such as split
+    # normals), and weld seam duplicates otherwise (the elk layout's OBJ exports).
+    vertices, faces = read_mesh(weld=False)
     indices = weights = None
     if files["weights"] is not None:
+        if weights_vertex_count(files["weights"]) != len(vertices):
+            vertices, faces = read_mesh(weld=True)
         indices, weights = load_weights(files["weights"], skeleton, len(vertices))
     else:
+        vertices, faces = read_mesh(weld=True)
         warnings.warn(f"{folder}: no weights file; computed weights by inverse distance to "
                       f"the bones ({weights_method})", WeightsComputedWarning, stacklevel=2)
     clips = {}

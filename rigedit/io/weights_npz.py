@@ -10,7 +10,7 @@ import numpy as np
 from ..errors import RigFileError
 from .atomic import atomic_write
 
-__all__ = ["load_weights", "save_weights"]
+__all__ = ["load_weights", "save_weights", "weights_vertex_count"]
 
 
 def save_weights(path, indices, weights, joint_names):
@@ -19,6 +19,16 @@ def save_weights(path, indices, weights, joint_names):
         np.savez_compressed(fh, indices=np.asarray(indices, dtype=np.int32),
                             weights=np.asarray(weights, dtype=np.float32),
                             joints=np.asarray(joint_names, dtype=str))
+
+
+def weights_vertex_count(path):
+    """Number of vertices a weights file is for, or None when it cannot be read (then
+    :func:`load_weights` reports the problem)."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            return int(data["indices"].shape[0])
+    except Exception:  # any unreadable file: load_weights names the problem
+        return None
 
 
 def load_weights(path, skeleton, num_vertices):
