@@ -30,6 +30,13 @@ def front_vector(up):
     return np.array([0.0, 0.0, 1.0]) if up == "y" else np.array([0.0, -1.0, 0.0])
 
 
+def _nice_cell(size):
+    """Round a grid cell size to 1, 2 or 5 times a power of ten (model units)."""
+    exp = np.floor(np.log10(size))
+    base = size / 10 ** exp
+    return float((1 if base < 1.5 else 2 if base < 3.5 else 5) * 10 ** exp)
+
+
 def faces_to_vtk(faces):
     """(F, 3) triangles -> pyvista's flat ``[3, a, b, c, ...]`` cell array."""
     faces = np.asarray(faces, dtype=np.int64)
@@ -90,13 +97,16 @@ class RigScene:
     # ------------------------------------------------------------------ actors
     def _add_floor(self):
         lo, hi = self.rig.bounds()
-        size = 2.5 * float(np.max(hi - lo))
-        center = 0.5 * (lo + hi)
-        ground = center.copy()
+        extent = float(np.max(hi - lo)) or 1.0
+        # Wide enough that a walk filmed with a following camera never reaches its edge;
+        # cells of a fixed size in model units so motion over the floor reads as speed.
+        cells = 60
+        size = cells * _nice_cell(extent / 4.0)
         axis = 1 if self.rig.up == "y" else 2
-        ground[axis] = min(0.0, lo[axis]) if lo[axis] > -0.05 * size else lo[axis]
+        ground = np.zeros(3)
+        ground[axis] = min(0.0, lo[axis]) if lo[axis] > -0.05 * extent else lo[axis]
         plane = pv.Plane(center=ground, direction=self.up, i_size=size, j_size=size,
-                         i_resolution=20, j_resolution=20)
+                         i_resolution=cells, j_resolution=cells)
         self.plotter.add_mesh(plane, color="#9aa3ad", opacity=0.35, name="rig-floor",
                               reset_camera=False, pickable=False)
         return self.plotter.add_mesh(plane.extract_all_edges(), color="#6b7580", opacity=0.5,
@@ -195,20 +205,28 @@ class RigScene:
         self.bones.Modified()
 
     # ------------------------------------------------------------------ camera
-    def view(self, name="front", angle=0.0, distance=2.2, target=None):
-        """Point the camera at the character.
+    def view(self, name="front", angle=0.0, distance=None, target=None, points=None):
+        """Point the camera at the character and frame it.
 
         Parameters
         ----------
         name : {"front", "side", "top", "back"}
         angle : float
             Degrees turned about the vertical axis (counter-clockwise seen from above).
-        distance : float
-            In units of the character's largest extent.
+        distance : float, optional
+            Camera distance in units of the character's largest extent; by default the
+            distance at which ``points`` just fit the window, plus a margin.
         target : (3,) float, optional
-            Point looked at; the rest mesh's centre when omitted.
+            Point looked at; the centre of the points' bounding box when omitted.
+        points : (N, 3) float, optional
+            What must be in frame; a sample of the rest mesh's vertices when omitted. A
+            recorder passes the vertices of several frames of its clip so raised hands and
+            swinging legs stay in frame.
         """
-        lo, hi = self.rig.bounds()
+        if points is None:
+            points = self.rig.vertices[::max(1, len(self.rig.vertices) // 4000)]
+        points = np.asarray(points, dtype=float)
+        lo, hi = points.min(axis=0), points.max(axis=0)
         center = 0.5 * (lo + hi) if target is None else np.asarray(target, dtype=float)
         extent = float(np.max(hi - lo)) or 1.0
         side = np.cross(self.up, self.front)  # the character's left, seen from the front
@@ -220,12 +238,33 @@ class RigScene:
             direction = (direction * np.cos(a) + np.cross(self.up, direction) * np.sin(a))
             direction = direction + 0.15 * self.up  # a little from above, as a person sees it
         direction = direction / np.linalg.norm(direction)
+        cam_up = -self.front if name == "top" else self.up
         cam = self.plotter.camera
+        if distance is None:
+            dist = self._fit_distance(points, center, direction, cam_up, cam.view_angle)
+        else:
+            dist = distance * extent
         cam.focal_point = center
-        cam.position = center + direction * distance * extent
-        cam.up = self.front * -1 if name == "top" else self.up
+        cam.position = center + direction * dist
+        cam.up = cam_up
         self.plotter.reset_camera_clipping_range()
         self._view = (name, angle, distance)
+
+    def _fit_distance(self, points, center, direction, cam_up, view_angle, margin=1.08):
+        """Distance along ``direction`` at which all ``points`` fit the viewport: a point at
+        lateral offset ``a`` and depth ``z`` towards the camera needs ``a / tan + z``."""
+        corners = points - center
+        up = cam_up - np.dot(cam_up, direction) * direction
+        up /= np.linalg.norm(up)
+        right = np.cross(direction, up)
+        width, height = self.plotter.window_size
+        aspect = width / height if width > 1 and height > 1 else 4.0 / 3.0  # not shown yet
+        tan_v = np.tan(np.radians(view_angle) / 2.0)
+        tan_h = tan_v * aspect
+        depth = corners @ direction  # corners nearer the camera need more room
+        need_v = np.abs(corners @ up) / tan_v + depth
+        need_h = np.abs(corners @ right) / tan_h + depth
+        return margin * float(max(need_v.max(), need_h.max()))
 
     def follow(self, offset):
         """Shift the camera by ``offset`` (3,) model units, to track root motion."""
