@@ -100,7 +100,7 @@ class RigScene:
         extent = float(np.max(hi - lo)) or 1.0
         # Wide enough that a walk filmed with a following camera never reaches its edge;
         # cells of a fixed size in model units so motion over the floor reads as speed.
-        cells = 60
+        cells = 40
         size = cells * _nice_cell(extent / 4.0)
         axis = 1 if self.rig.up == "y" else 2
         ground = np.zeros(3)
@@ -110,13 +110,13 @@ class RigScene:
         self.plotter.add_mesh(plane, color="#9aa3ad", opacity=0.35, name="rig-floor",
                               reset_camera=False, pickable=False)
         return self.plotter.add_mesh(plane.extract_all_edges(), color="#6b7580", opacity=0.5,
-                                     name="rig-floor-grid", reset_camera=False, pickable=False)
+                                     name="rig-grid", reset_camera=False, pickable=False)
 
     def set_skeleton_visible(self, visible):
         self.bone_actor.SetVisibility(bool(visible))
 
     def set_floor_visible(self, visible):
-        for name in ("rig-floor", "rig-floor-grid"):
+        for name in ("rig-floor", "rig-grid"):
             actor = self.plotter.actors.get(name)
             if actor is not None:
                 actor.SetVisibility(bool(visible))
