@@ -91,6 +91,20 @@ def main(argv):
     if cmd == "test":
         say("running the tests")
         return subprocess.run([str(PY), "-m", "pytest", *rest], cwd=ROOT, env=env).returncode
+    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        # No screen (a server, CI): show what the editor would, as a screenshot taken on a
+        # virtual display, and a video of the default walk, and say where they are.
+        out = ROOT / "out"
+        out.mkdir(exist_ok=True)
+        say("no display: saving a screenshot of the editor and a video of the walk instead")
+        xvfb = ["xvfb-run", "-a", "-s", "-screen 0 1600x1000x24"] if shutil.which("xvfb-run") else []
+        code = subprocess.run([*xvfb, str(PY), str(ROOT / "app.py"), "--screenshot",
+                               str(out / "editor.png"), *rest], cwd=ROOT, env=env).returncode
+        if code == 0:
+            code = subprocess.run([*xvfb, str(PY), "-m", "rigedit", "render", "walk",
+                                   *(["--rig", rest[0]] if rest else []), "-o",
+                                   str(out / "walk.mp4")], cwd=ROOT, env=env).returncode
+        return code
     return subprocess.run([str(PY), str(ROOT / "app.py"), *rest], cwd=ROOT, env=env).returncode
 
 

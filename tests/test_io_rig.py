@@ -171,3 +171,20 @@ def test_round_trip_keeps_coincident_vertices(tmp_path):
     back = load_rig_folder(tmp_path / "t")
     assert len(back.vertices) == len(dup)
     assert np.allclose(back.binding.dense(), twin.binding.dense(), atol=1e-6)
+
+
+def test_atomic_write_gives_normal_file_permissions(tmp_path):
+    import os
+
+    umask = os.umask(0o022)
+    try:
+        with atomic_write(tmp_path / "new.json") as fh:
+            fh.write("{}")
+        assert (tmp_path / "new.json").stat().st_mode & 0o777 == 0o644
+        (tmp_path / "old.json").write_text("x")
+        os.chmod(tmp_path / "old.json", 0o640)
+        with atomic_write(tmp_path / "old.json") as fh:
+            fh.write("y")
+        assert (tmp_path / "old.json").stat().st_mode & 0o777 == 0o640
+    finally:
+        os.umask(umask)

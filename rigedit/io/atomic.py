@@ -7,7 +7,23 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_write", "write_json"]
+__all__ = ["atomic_write", "write_json", "temp_beside"]
+
+
+def temp_beside(path, suffix=None):
+    """Create an empty temporary file next to ``path`` (same folder, so a rename is atomic)
+    with the permissions a new file would get (``mkstemp`` makes it 0600), or the target's
+    own when it exists. Returns ``(fd, tmp_path)``."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or ".tmp", dir=path.parent)
+    try:
+        mode = path.stat().st_mode & 0o777
+    except OSError:
+        umask = os.umask(0)
+        os.umask(umask)
+        mode = 0o666 & ~umask
+    os.chmod(tmp, mode)
+    return fd, tmp
 
 
 @contextlib.contextmanager
@@ -20,7 +36,7 @@ def atomic_write(path, mode="w", suffix=None):
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or ".tmp", dir=path.parent)
+    fd, tmp = temp_beside(path, suffix)
     try:
         with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8"})) as fh:
             yield fh

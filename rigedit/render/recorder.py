@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import pyvista as pv
 
 from ..errors import RigFileError
+from ..io.atomic import temp_beside
 from .scene import RigScene
 
 __all__ = ["record_clip", "frame_times", "camera_state", "apply_camera", "VIDEO_SUFFIXES",
@@ -49,8 +49,7 @@ class _Writer:
         self.path = Path(path)
         self.fps = fps
         self.gif = self.path.suffix.lower() == ".gif"
-        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.stem}.", suffix=self.path.suffix,
-                                   dir=self.path.parent)
+        fd, tmp = temp_beside(self.path, suffix=self.path.suffix)
         os.close(fd)
         self.tmp = Path(tmp)
         self.frames = []
