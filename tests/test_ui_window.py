@@ -331,8 +331,9 @@ def test_screenshot_shows_the_model(window, tmp_path):
     assert a.std() > 10  # not blank
     diff = np.abs(a - b).sum(axis=2) > 30
     ys, xs = np.nonzero(diff)
-    assert diff.mean() > 0.03  # the mesh covers a good part of the window
-    # ... within the 3D view, around its middle
+    # the mesh covers a good part of the 3D view (measured: about 9% on the default rig)
     view = window.plotter.geometry()
+    assert diff.sum() / (view.width() * view.height()) > 0.05
+    # ... within the 3D view, around its middle
     cx, cy = xs.mean(), ys.mean()
     assert view.left() < cx < view.right() and view.top() < cy < view.bottom() + 60

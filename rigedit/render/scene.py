@@ -78,7 +78,10 @@ class RigScene:
         self.mesh_actor = plotter.add_mesh(self._normals, color=MESH_COLOR, smooth_shading=True,
                                            specular=0.25, specular_power=20, name="rig-mesh")
         sk = rig.skeleton
-        child = np.flatnonzero(sk.parents >= 0)
+        # No line from a non-deforming root (a ground-level carrier) to its children: that
+        # "bone" moves no skin and would cut through the body down to the floor.
+        carrier = (sk.parents < 0) & ~sk.deform
+        child = np.flatnonzero((sk.parents >= 0) & ~carrier[np.maximum(sk.parents, 0)])
         lines = np.column_stack([np.full(len(child), 2), sk.parents[child], child]).ravel()
         self.bones = pv.PolyData(sk.bind_matrices[:, :3, 3].copy())
         if len(child):
