@@ -20,12 +20,14 @@ def build_character(name, joint_list, prims_fn, regions, clips_fn, spacing, targ
     parents = [j[1] for j in joint_list]
     H = {j[0]: np.array(j[2], float) for j in joint_list}
     prims = prims_fn(H)
-    verts, faces = sdf.mesh_from_prims(prims, spacing, target_vertices)
+    verts, faces = sdf.mesh_from_prims([p for p in prims if p.role != "weights"], spacing,
+                                       target_vertices)
     rep = sdf.edge_report(faces)
     if any(rep.values()):
         raise RuntimeError(f"{name}: mesh not closed/manifold/oriented: {rep}")
     # Weights in the modelling frame, before the mesh is set on the ground.
-    indices, weights = primitive_weights(verts, prims, names, regions, offset=weight_offset)
+    indices, weights = primitive_weights(verts, [p for p in prims if p.role != "mesh"], names,
+                                         regions, offset=weight_offset)
     # Stand on y = 0: lift everything but the ground-level root.
     dy = -verts[:, 1].min()
     verts = np.round(verts + [0, dy, 0], 6)

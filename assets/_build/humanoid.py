@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .sdf import cone, ell
+from .sdf import cone, ell, sweep
 
 _SIDE = (("Left", 1.0), ("Right", -1.0))
 
@@ -45,9 +45,13 @@ def prims(H):
     e = lambda *a, **k: P.append(ell(*a, **k))  # noqa: E731
     B = 0.06
     e("Hips", (0, 0.95, -0.005), (0.16, 0.11, 0.11), blend=B)
-    e("Spine", (0, 1.09, 0.0), (0.14, 0.11, 0.095), blend=B)
-    e("Spine1", (0, 1.22, 0.0), (0.15, 0.12, 0.105), blend=B)
-    e("Spine2", (0, 1.35, -0.01), (0.17, 0.11, 0.11), blend=B)
+    # Torso: one smooth tube up the spine (section wider than deep, varying smoothly), so
+    # the waist and ribs show no seams; the weights still go per spine joint.
+    P.extend(sweep(["Hips", "Spine", "Spine1", "Spine2"],
+                   [(0, 0.93, -0.005), (0, 1.02, 0.0), (0, 1.155, 0.0), (0, 1.285, -0.005),
+                    (0, 1.41, -0.01)], [0.13, 0.138, 0.145, 0.16, 0.13],
+                   squash=(2, 1, [0.9, 1.09, 1.22, 1.35, 1.5], [0.7, 0.68, 0.7, 0.68, 0.68]),
+                   blend=B))
     e("Spine2", (0, 1.30, 0.045), (0.13, 0.08, 0.07), blend=B)   # chest
     c("Neck", (0, 1.44, -0.015), (0, 1.61, 0.0), 0.055, 0.048, blend=0.04)
     e("Head", (0, 1.675, 0.01), (0.078, 0.10, 0.098), blend=0.04)
@@ -57,16 +61,17 @@ def prims(H):
         e("Hips", (0.07 * x, 0.90, -0.055), (0.085, 0.09, 0.07), blend=B)   # buttock
         e("Head", (0.08 * x, 1.667, 0.0), (0.012, 0.028, 0.018), blend=0.012)  # ear
         sh, arm, fa, hand = (H[f"{s}{n}"] for n in ("Shoulder", "Arm", "ForeArm", "Hand"))
-        c(f"{s}Shoulder", sh + (0, -0.02, 0), arm, 0.06, 0.055, blend=0.05)
-        c(f"{s}Arm", arm, fa, 0.052, 0.04, blend=0.04)
-        c(f"{s}ForeArm", fa, hand, 0.04, 0.03, blend=0.03)
+        # Limbs as one tube each (no bulge at elbow and knee where two pieces would blend).
+        P.extend(sweep([f"{s}Shoulder", f"{s}Arm", f"{s}ForeArm"],
+                       [sh + (0, -0.02, 0), arm, fa, hand], [0.06, 0.053, 0.04, 0.03],
+                       blend=0.05))
         e(f"{s}Hand", hand + (0.075 * x, 0, 0), (0.075, 0.02, 0.045), axis_z=(1, 0, 0),
           blend=0.02)
         c(f"{s}Hand", hand + (0.02 * x, -0.005, 0.03), hand + (0.07 * x, -0.01, 0.065), 0.014,
           0.011, blend=0.015)   # thumb
         up, kn, an, toe = (H[f"{s}{n}"] for n in ("UpLeg", "Leg", "Foot", "ToeBase"))
-        c(f"{s}UpLeg", up, kn, 0.085, 0.055, blend=0.05)
-        c(f"{s}Leg", kn, an, 0.052, 0.037, blend=0.04)
+        P.extend(sweep([f"{s}UpLeg", f"{s}Leg"], [up, kn, an], [0.085, 0.053, 0.037],
+                       blend=0.05))
         e(f"{s}Leg", (0.09 * x, 0.37, -0.025), (0.05, 0.11, 0.05), blend=0.04)   # calf
         e(f"{s}Foot", (0.09 * x, 0.045, 0.025), (0.045, 0.04, 0.1), axis_z=(0, -0.05, 1),
           blend=0.03)

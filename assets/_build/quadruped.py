@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .sdf import cone, ell
+from .sdf import cone, ell, sweep
 
 # name, parent, head, tail (None: bone ends at its child)
 _SIDE = ("L", 1.0), ("R", -1.0)
@@ -71,20 +71,23 @@ def prims(H):
     c = lambda *a, **k: P.append(cone(*a, **k))  # noqa: E731
     e = lambda *a, **k: P.append(ell(*a, **k))  # noqa: E731
     B = 0.09
-    # Trunk: rump, barrel, chest, withers.
-    e("pelvis", (0, 1.07, -0.56), (0.19, 0.22, 0.25), blend=B)
-    e("spine_1", (0, 1.01, -0.26), (0.23, 0.27, 0.26), blend=B)
-    e("spine_2", (0, 1.00, 0.02), (0.24, 0.29, 0.26), blend=B)
-    e("spine_3", (0, 1.03, 0.27), (0.20, 0.29, 0.22), blend=B)
-    e("spine_3", (0, 1.20, 0.22), (0.10, 0.10, 0.18), blend=B)
-    c("pelvis", H["pelvis"] + (0, -0.03, -0.05), H["spine_1"] + (0, -0.03, 0), 0.15, 0.16, blend=B)
-    c("spine_1", H["spine_1"] + (0, -0.03, 0), H["spine_2"] + (0, -0.03, 0), 0.16, 0.16, blend=B)
-    c("spine_2", H["spine_2"] + (0, -0.03, 0), H["spine_3"] + (0, -0.02, 0), 0.16, 0.15, blend=B)
-    # Neck (thick, with a throat mane) and head.
-    c("neck_1", (0, 1.18, 0.42), H["neck_2"], 0.17, 0.13, blend=0.08)
-    c("neck_2", H["neck_2"], H["neck_3"], 0.13, 0.11, blend=0.06)
-    c("neck_3", H["neck_3"], H["head"] + (0, -0.02, 0.03), 0.11, 0.10, blend=0.05)
-    e("neck_1", (0, 1.20, 0.55), (0.10, 0.16, 0.10), axis_z=(0, 0.6, 0.8), blend=0.08)
+    # Trunk: one smooth tube from rump to brisket along a spline through the spine, its
+    # section an ellipse (narrower at the chest) whose size varies smoothly, so the barrel has
+    # no seams where per-joint pieces would meet. The weights still go per spine joint.
+    z = np.array([-0.69, -0.56, -0.405, -0.26, -0.12, 0.02, 0.15, 0.34])
+    y = np.array([1.09, 1.07, 1.045, 1.03, 1.02, 1.01, 1.02, 1.07])
+    r = np.array([0.12, 0.21, 0.245, 0.265, 0.28, 0.29, 0.29, 0.24])
+    P.extend(sweep(["pelvis", "pelvis", "spine_1", "spine_1", "spine_2", "spine_2", "spine_3"],
+                   np.stack([0 * z, y, z], axis=1), r,
+                   squash=(0, 2, [-0.8, -0.56, -0.3, 0.02, 0.27, 0.6],
+                           [0.88, 0.9, 0.88, 0.83, 0.72, 0.75]), blend=B))
+    # Neck: one tube from inside the chest to the head, deep at the base (throat), slimmer
+    # than deep all along.
+    P.extend(sweep(["neck_1", "neck_1", "neck_2", "neck_3"],
+                   [(0, 1.14, 0.36), (0, 1.28, 0.50), H["neck_2"], H["neck_3"],
+                    H["head"] + (0, -0.02, 0.03)],
+                   [0.17, 0.15, 0.125, 0.105, 0.095],
+                   squash=(0, 2, [0.0, 1.0], [0.8, 0.8]), blend=0.08))
     e("head", (0, 1.67, 0.86), (0.085, 0.095, 0.12), axis_z=(0, -0.35, 1), blend=0.05)
     c("head", (0, 1.65, 0.90), (0, 1.53, 1.15), 0.08, 0.055, blend=0.05)
     e("head", (0, 1.52, 1.16), (0.055, 0.05, 0.055), blend=0.03)

@@ -24,8 +24,20 @@ class Prim:
     radii: np.ndarray = None
     rot: np.ndarray = None
     blend: float = 0.03
+    pts: np.ndarray = None      # kind 'chain': centreline samples (N, 3)
+    rads: np.ndarray = None     # kind 'chain': radius per sample (N,)
+    squash: tuple = None        # kind 'chain': (axis, along, spline) axis scaled by s(p[along])
+    role: str = "both"          # 'mesh': shape only, 'weights': skinning only, 'both'
 
     def bounds(self):
+        if self.kind == "chain":
+            r = self.rads[:, None]
+            lo, hi = np.min(self.pts - r, axis=0), np.max(self.pts + r, axis=0)
+            if self.squash is not None:
+                ax, _, spl = self.squash
+                smax = float(np.max(spl(np.linspace(spl.x[0], spl.x[-1], 200))))
+                lo[ax], hi[ax] = lo[ax] * max(smax, 1.0), hi[ax] * max(smax, 1.0)
+            return lo - self.blend, hi + self.blend
         if self.kind == "cone":
             r = max(self.r1, self.r2)
             lo = np.minimum(self.a, self.b) - r
@@ -39,6 +51,8 @@ class Prim:
         """(N,) signed distance of points (N, 3) (approximate for ellipsoids)."""
         if self.kind == "cone":
             return round_cone(p, self.a, self.b, self.r1, self.r2)
+        if self.kind == "chain":
+            return chain_sdf(p, self.pts, self.rads, self.squash)
         q = (p - self.a) @ self.rot
         k0 = np.linalg.norm(q / self.radii, axis=-1)
         k1 = np.linalg.norm(q / (self.radii * self.radii), axis=-1)
@@ -62,6 +76,75 @@ def ell(owner, centre, radii, axis_z=None, blend=0.03, axis_y=(0, 1, 0)):
     y = np.cross(z, x)
     return Prim("ell", owner, np.asarray(centre, float), radii=np.asarray(radii, float),
                 rot=np.stack([x, y, z], axis=1), blend=blend)
+
+
+def sweep(owners, ctrl, radii, squash=None, blend=0.05, seg_len=0.03):
+    """A smooth variable-radius tube: a cubic spline through the control points ``ctrl``
+    with radii interpolated by a cubic spline too, sampled into short round cones whose union
+    (a hard minimum, so no bulge where two meet) is one continuous smooth surface.
+
+    ``owners``: one joint name per control interval (len(ctrl) - 1), used for the weights.
+    ``squash``: optional (axis, along, knots, values): the section is scaled along ``axis``
+    by a smooth function of the coordinate ``along`` (an elliptic, varying section).
+    Returns one prim for the shape and one weight-only prim per owner run.
+    """
+    from scipy.interpolate import CubicSpline
+
+    ctrl = np.asarray(ctrl, float)
+    t = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(ctrl, axis=0), axis=1))])
+    cs = CubicSpline(t, ctrl, bc_type="natural")
+    rs = CubicSpline(t, np.asarray(radii, float), bc_type="natural")
+    n = max(int(np.ceil(t[-1] / seg_len)), 2)
+    ts = np.linspace(0, t[-1], n + 1)
+    pts, rads = cs(ts), rs(ts)
+    sq = None
+    if squash is not None:
+        axis, along, knots, values = squash
+        sq = (axis, along, CubicSpline(knots, values, bc_type="clamped"))
+    out = [Prim("chain", owners[0], a=pts[0], pts=pts, rads=rads, squash=sq, blend=blend,
+                role="mesh")]
+    seg_owner = [owners[min(np.searchsorted(t, 0.5 * (ts[i] + ts[i + 1])) - 1,
+                            len(owners) - 1)] for i in range(n)]
+    i = 0
+    while i < n:
+        j = i
+        while j < n and seg_owner[j] == seg_owner[i]:
+            j += 1
+        out.append(Prim("chain", seg_owner[i], a=pts[i], pts=pts[i:j + 1], rads=rads[i:j + 1],
+                        squash=sq, blend=blend, role="weights"))
+        i = j
+    return out
+
+
+def chain_sdf(p, pts, rads, squash=None):
+    """Union (hard minimum) of the round cones between consecutive samples."""
+    p = np.asarray(p, float)
+    if squash is not None:
+        axis, along, spl = squash
+        s = spl(np.clip(p[:, along], spl.x[0], spl.x[-1]))
+        p = p.copy()
+        p[:, axis] /= s
+    out = np.full(len(p), np.inf)
+    margin = 0.2
+    for i in range(len(pts) - 1):
+        a, b, r1, r2 = pts[i], pts[i + 1], rads[i], rads[i + 1]
+        r = max(r1, r2) + margin
+        lo, hi = np.minimum(a, b) - r, np.maximum(a, b) + r
+        m = np.all((p >= lo) & (p <= hi), axis=1)
+        if not m.any():
+            continue
+        idx = np.nonzero(m)[0]
+        out[idx] = np.minimum(out[idx], round_cone(p[idx], a, b, r1, r2))
+    far = ~np.isfinite(out)
+    if far.any():
+        # Outside every segment's box: at least ``margin`` away, which is all a field that
+        # only matters within a blend width of the surface needs; few points: exact.
+        q = p[far]
+        if len(q) * len(pts) <= 4_000_000:
+            out[far] = np.min(np.linalg.norm(q[:, None, :] - pts[None], axis=-1) - rads, axis=1)
+        else:
+            out[far] = margin
+    return out
 
 
 def round_cone(p, a, b, r1, r2):
