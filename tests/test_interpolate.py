@@ -224,3 +224,20 @@ def test_modes_are_validated_per_channel():
         Track("rotation", [0, 1], [[0, 0, 0, 1]] * 2, "cubic")
     assert Track("rotation", [0], [[0, 0, 0, 1]], "linear").interpolation == "nlerp"
     assert set(VECTOR_MODES) | set(ROTATION_MODES) == set(MODES)
+
+
+def test_catmull_rom_closed_track_is_c1_across_the_loop_point():
+    times = np.array([0.0, 0.3, 0.9, 1.2, 2.0])
+    v = np.array([[0, 0, 0], [1, 0.5, 0], [1.5, -0.2, 0.3], [0.4, 0.8, 0], [0, 0, 0.0]])
+    tr = Track("translation", times, v, "catmull_rom")
+    h = 1e-5
+    f = tr.sample
+    end_velocity = (3 * f(2.0) - 4 * f(2.0 - h) + f(2.0 - 2 * h)) / (2 * h)
+    start_velocity = (-3 * f(0.0) + 4 * f(h) - f(2 * h)) / (2 * h)
+    np.testing.assert_allclose(end_velocity, start_velocity, rtol=1e-3, atol=1e-3)
+    # an open track keeps secant end slopes, which differ here: the check can fail
+    open_tr = Track("translation", times, np.vstack([v[:-1], [[0.1, 0, 0]]]), "catmull_rom")
+    g = open_tr.sample
+    end_open = (3 * g(2.0) - 4 * g(2.0 - h) + g(2.0 - 2 * h)) / (2 * h)
+    start_open = (-3 * g(0.0) + 4 * g(h) - g(2 * h)) / (2 * h)
+    assert np.linalg.norm(end_open - start_open) > 0.5

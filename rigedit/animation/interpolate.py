@@ -37,7 +37,9 @@ knots. So the tangent at each key is the centripetal one (Barry-Goldman closed f
 to units per second with the knot-per-second rate of its two neighbouring segments, and each
 segment is a cubic Hermite in time: the curve passes through the keys and its velocity is
 continuous in time. With knots proportional to key times this is exactly the centripetal
-Catmull-Rom. End keys use the secant slope (a reflected phantom key).
+Catmull-Rom. End keys use the secant slope (a reflected phantom key), except on a closed track
+(last key equal to the first, as looping clips have), whose ends take the tangent through the
+wrap-around neighbours so the loop point is C1 as well.
 """
 from __future__ import annotations
 
@@ -147,6 +149,12 @@ def catmull_rom_tangents(times, values, alpha=ALPHA):
         m = dp[:-1] / d0 - (dp[:-1] + dp[1:]) / (d0 + d1) + dp[1:] / d1
         rate = (d0 + d1) / (dt[:-1, None] + dt[1:, None])    # knots per second around the key
         out[1:-1] = m * rate
+        if np.allclose(p[0], p[-1], atol=1e-9, rtol=0):
+            # A closed track (last key = first key, as in a looping clip): the ends get the
+            # tangent through the wrap-around neighbours, so the loop point is C1 too.
+            d0, d1 = dk[-1], dk[0]
+            m = dp[-1] / d0 - (dp[-1] + dp[0]) / (d0 + d1) + dp[0] / d1
+            out[0] = out[-1] = m * (d0 + d1) / (dt[-1] + dt[0])
     return out
 
 
