@@ -316,6 +316,8 @@ class MainWindow(QtWidgets.QMainWindow):
     # ================================================================== scene
     def _load_scene(self):
         """(Re)build the 3D scene and panels for the document's rig."""
+        if self.axes is not None:
+            self.axes.remove()
         if self.gizmos is not None:
             self.gizmos.remove()
         self.plotter.clear()
@@ -336,7 +338,11 @@ class MainWindow(QtWidgets.QMainWindow):
                                   self._drag_start, self._drag_move, self._drag_end,
                                   renderer=self.overlay)
         self.gizmos.set_visible(self.gizmos_action.isChecked())
-        self.axes = AxisHandles(self.plotter, 10 * self.radius, renderer=self.overlay)
+        # The selected joint's X/Y/Z arrows are handles: a drag on one runs the same code
+        # as a sphere drag, constrained to that axis.
+        self.axes = AxisHandles(self.plotter, 10 * self.radius, renderer=self.overlay,
+                                on_start=self._axis_drag_start, on_move=self._axis_drag_move,
+                                on_end=self._axis_drag_end, gizmos=self.gizmos)
         self.axes.set_axis(self.axis)
         self.joint_panel.set_skeleton(rig.skeleton)
         self.info_panel.show_rig(rig)
@@ -488,29 +494,33 @@ class MainWindow(QtWidgets.QMainWindow):
             "color: #ffd27a; font-weight: bold" if self.mode == "edit" else "color: #9fd0ff")
 
     # ================================================================== gizmo drags
-    def _drag_start(self, j):
+    def _drag_start(self, j, axis=None):
+        """A drag of joint ``j`` begins: constrained to ``axis`` (an arrow handle's) or to
+        the toolbar's axis."""
         d = self.document
         if self.job is not None:
             self.status("Busy: wait for the current job or cancel it")
         d.select(j)
         self._interacting = True
         self._drag = {"joint": j, "start": self.gizmos.center(j),
+                      "axis": self.axis if axis is None else axis,
                       "pose": d.pose_snapshot(), "work": d.pose.copy()}
         if self.mode == "pose":
             d.begin_drag()
 
-    def _constrain(self, start, center):
-        if self.axis is None:
+    @staticmethod
+    def _constrain(start, center, axis):
+        if axis is None:
             return center
-        e = np.eye(3)[self.axis]
+        e = np.eye(3)[axis]
         return start + np.dot(center - start, e) * e
 
     def _drag_move(self, j, center):
         drag = self._drag
         if drag is None or drag["joint"] != j:
             return
-        target = self._constrain(drag["start"], center)
-        if self.axis is not None:
+        target = self._constrain(drag["start"], center, drag["axis"])
+        if drag["axis"] is not None:
             self.gizmos.set_center(j, target)
         drag["target"] = target
         if self.mode == "pose":
@@ -547,6 +557,20 @@ class MainWindow(QtWidgets.QMainWindow):
         elif "target" in drag and not np.allclose(drag["target"], drag["start"]):
             self.rebind_moved_joint(j, drag["target"])
         self.request_render()
+
+    # An arrow handle drag: the selected joint, constrained to the arrow's axis.
+    def _axis_drag_start(self, axis):
+        j = self.document.selection
+        if j is not None:
+            self._drag_start(j, axis=axis)
+
+    def _axis_drag_move(self, axis, target):
+        if self._drag is not None:
+            self._drag_move(self._drag["joint"], target)
+
+    def _axis_drag_end(self, axis):
+        if self._drag is not None:
+            self._drag_end(self._drag["joint"])
 
     def _euler_live(self, j, angles):
         self.document.begin_drag()
@@ -705,6 +729,8 @@ class MainWindow(QtWidgets.QMainWindow):
         if self.job is not None:
             self.job.cancel()
             self.job.wait(5000)
+        if self.axes is not None:
+            self.axes.remove()
         if self.gizmos is not None:
             self.gizmos.remove()
         self.plotter.close()
