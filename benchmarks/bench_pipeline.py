@@ -22,6 +22,7 @@ from threadpoolctl import threadpool_limits
 
 from rigedit.model import Pose, Skeleton, SkinBinding, local_to_model, skinning_matrices
 from rigedit.model.skinning import top_k_influences
+from rigedit.model.weights import compute_weights
 
 J, K = 40, 4
 
@@ -93,6 +94,17 @@ def main():
               f"{nbytes / bw / 1e6:>29.2f}")
 
 
+def bench_weights(rng):
+    """Automatic weights (inverse distance) for 100k vertices and a 40-joint skeleton."""
+    parents = np.r_[-1, [rng.integers(0, j) for j in range(1, J)]]
+    sk = Skeleton([f"j{i}" for i in range(J)], parents, rng.normal(size=(J, 3)))
+    verts = rng.normal(size=(100_000, 3))
+    ms = median_ms(lambda: compute_weights(verts, sk, "idw", K), 5)
+    print(f"idw weights, 100,000 vertices, {J} joints ({len(sk.bone_segments()[2])} bone "
+          f"segments): {ms / 1e3:.2f} s (median of 5)")
+
+
 if __name__ == "__main__":
     with threadpool_limits(1):
         main()
+        bench_weights(np.random.default_rng(1))
