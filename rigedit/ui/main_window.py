@@ -13,12 +13,13 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 from pyvistaqt import QtInteractor
 
 from ..document import Document
-from ..model.ik import drag_joint
 from ..render.gizmos import AxisHandles, JointGizmos, gizmo_radius, overlay_renderer
 from ..render.scene import RigScene
+from .drag import DragMixin
+from .menus import MenusMixin
 from .file_actions import FileActions
 from .joint_panel import InfoPanel, JointPanel
-from .jobs import Job, weights_in_chunks
+from .jobs import Job
 
 __all__ = ["MainWindow", "default_rig"]
 
@@ -46,7 +47,7 @@ def default_rig():
         return demo_rig(), f"bundled quadruped not available ({exc}); showing a demo creature"
 
 
-class MainWindow(QtWidgets.QMainWindow):
+class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
     """The rig editor.
 
     Parameters
@@ -124,136 +125,6 @@ class MainWindow(QtWidgets.QMainWindow):
                 plotter.update()
 
         iren.AddObserver("RenderEvent", on_render_request)
-
-    def _action(self, text, slot, shortcut=None, checkable=False, checked=False, tip=None):
-        act = QtWidgets.QAction(text, self)
-        if shortcut:
-            act.setShortcut(QtGui.QKeySequence(shortcut))
-        act.setCheckable(checkable)
-        if checkable:
-            act.setChecked(checked)
-            act.toggled.connect(slot)
-        else:
-            act.triggered.connect(slot)
-        if tip:
-            act.setStatusTip(tip)
-            act.setToolTip(tip)
-        return act
-
-    def _build_actions(self):
-        f = self.files
-        bar = self.menuBar()
-        m = bar.addMenu("&File")
-        m.addAction(self._action("&Open rig folder...", f.open_folder, "Ctrl+O"))
-        m.addAction(self._action("Open mesh + skeleton...", f.open_mesh_skeleton))
-        m.addSeparator()
-        m.addAction(self._action("&Save rig", f.save, "Ctrl+S"))
-        m.addAction(self._action("Save rig &as...", f.save_as, "Ctrl+Shift+S"))
-        m.addSeparator()
-        m.addAction(self._action("Export pose (JSON)...", f.export_pose))
-        m.addAction(self._action("Export skeleton (JSON)...", f.export_skeleton))
-        m.addSeparator()
-        m.addAction(self._action("Load weights...", f.load_weights))
-        m.addAction(self._action("Save weights...", f.save_weights))
-        m.addAction(self._action("&Recompute weights", f.recompute_weights, "Ctrl+R"))
-        m.addSeparator()
-        m.addAction(self._action("Save screenshot...", f.save_screenshot))
-        m.addAction(self._action("&Quit", self.close, "Ctrl+Q"))
-
-        m = bar.addMenu("&Edit")
-        self.undo_action = self._action("&Undo", self.document.undo, QtGui.QKeySequence.Undo)
-        self.redo_action = self._action("&Redo", self.document.redo, QtGui.QKeySequence.Redo)
-        m.addAction(self.undo_action)
-        m.addAction(self.redo_action)
-        m.addSeparator()
-        m.addAction(self._action("Reset joint", self._reset_selected, "Alt+R"))
-        m.addAction(self._action("Reset pose", self.document.reset_pose, "Alt+Shift+R"))
-        m.addAction(self._action("Mirror pose L → R", lambda: self.document.mirror_pose("L")))
-        m.addAction(self._action("Mirror pose R → L", lambda: self.document.mirror_pose("R")))
-
-        view = bar.addMenu("&View")
-        self.display_group = QtWidgets.QActionGroup(self)
-        self.display_actions = {}
-        for key, (mode, label) in enumerate((("solid", "Solid"),
-                                             ("translucent", "Translucent + wireframe"),
-                                             ("wireframe", "Wireframe")), start=1):
-            act = self._action(label, lambda on, m_=mode: on and self.set_display_mode(m_),
-                               f"Ctrl+{key}", checkable=True, checked=mode == "solid")
-            self.display_group.addAction(act)
-            self.display_actions[mode] = act
-            view.addAction(act)
-        view.addSeparator()
-        self.skeleton_action = self._action("Show skeleton", self.set_skeleton_visible, "Ctrl+B",
-                                            checkable=True, checked=True)
-        self.gizmos_action = self._action("Show joint gizmos", self.set_gizmos_visible, "Ctrl+G",
-                                          checkable=True, checked=True)
-        self.weights_action = self._action(
-            "Weight paint view", self.set_weights_view, "Ctrl+W", checkable=True,
-            tip="Colour the mesh by the selected joint's influence (blue 0 → red 1)")
-        self.floor_action = self._action("Show floor", self._set_floor_visible,
-                                         checkable=True, checked=True)
-        for a in (self.skeleton_action, self.gizmos_action, self.weights_action,
-                  self.floor_action):
-            view.addAction(a)
-        view.addSeparator()
-        self.camera_actions = []
-        for key, name in (("1", "front"), ("3", "side"), ("7", "top"), ("Ctrl+3", "back")):
-            act = self._action(f"{name.capitalize()} view", lambda _=False, n=name: self.view(n),
-                               key)
-            self.camera_actions.append(act)
-            view.addAction(act)
-        view.addAction(self._action("Reset camera", lambda: self.view("reset"), "Home"))
-
-        tb = self.addToolBar("Tools")
-        tb.setObjectName("tools")
-        tb.setMovable(False)
-        tb.setIconSize(QtCore.QSize(16, 16))
-        tb.setToolButtonStyle(QtCore.Qt.ToolButtonTextOnly)
-        tb.addWidget(QtWidgets.QLabel(" Mode "))
-        self.mode_group = QtWidgets.QActionGroup(self)
-        self.pose_mode_action = self._action("Pose", lambda on: on and self.set_mode("pose"),
-                                             "Tab", checkable=True, checked=True,
-                                             tip="Pose mode: drag a joint to rotate its chain")
-        self.edit_mode_action = self._action(
-            "Edit (bind)", lambda on: on and self.set_mode("edit"), "Shift+Tab", checkable=True,
-            tip="Edit mode: drag a joint to move its rest position; the skin is re-bound")
-        for a in (self.pose_mode_action, self.edit_mode_action):
-            self.mode_group.addAction(a)
-            tb.addAction(a)
-        tb.addSeparator()
-        tb.addWidget(QtWidgets.QLabel(" IK chain "))
-        self.chain_spin = QtWidgets.QSpinBox()
-        self.chain_spin.setRange(1, 8)
-        self.chain_spin.setValue(self.chain_length)
-        self.chain_spin.setToolTip("Joints above the dragged one that rotate to reach it "
-                                   "(1: just aim the parent bone)")
-        self.chain_spin.valueChanged.connect(lambda v: setattr(self, "chain_length", int(v)))
-        tb.addWidget(self.chain_spin)
-        tb.addSeparator()
-        tb.addWidget(QtWidgets.QLabel(" Axis "))
-        self.axis_group = QtWidgets.QActionGroup(self)
-        self.axis_actions = []
-        for k, label in enumerate(("Free", "X", "Y", "Z")):
-            act = self._action(label, lambda on, a=k - 1: on and self.set_axis(None if a < 0 else a),
-                               None if k == 0 else f"Shift+{label}", checkable=True,
-                               checked=k == 0, tip="Constrain drags to this axis" if k else
-                               "Drag freely in the view plane")
-            self.axis_group.addAction(act)
-            self.axis_actions.append(act)
-            tb.addAction(act)
-        tb.addSeparator()
-        for mode in ("solid", "translucent", "wireframe"):
-            tb.addAction(self.display_actions[mode])
-        tb.addSeparator()
-        tb.addAction(self.skeleton_action)
-        tb.addAction(self.gizmos_action)
-        tb.addAction(self.weights_action)
-        tb.addSeparator()
-        for act in self.camera_actions[:3]:
-            tb.addAction(act)
-        reset = self._action("Reset view", lambda: self.view("reset"))
-        tb.addAction(reset)
-        self.toolbar = tb
 
     def _build_panels(self):
         self.joint_panel = JointPanel()
@@ -493,85 +364,6 @@ class MainWindow(QtWidgets.QMainWindow):
         self.mode_label.setStyleSheet(
             "color: #ffd27a; font-weight: bold" if self.mode == "edit" else "color: #9fd0ff")
 
-    # ================================================================== gizmo drags
-    def _drag_start(self, j, axis=None):
-        """A drag of joint ``j`` begins: constrained to ``axis`` (an arrow handle's) or to
-        the toolbar's axis."""
-        d = self.document
-        if self.job is not None:
-            self.status("Busy: wait for the current job or cancel it")
-        d.select(j)
-        self._interacting = True
-        self._drag = {"joint": j, "start": self.gizmos.center(j),
-                      "axis": self.axis if axis is None else axis,
-                      "pose": d.pose_snapshot(), "work": d.pose.copy()}
-        if self.mode == "pose":
-            d.begin_drag()
-
-    @staticmethod
-    def _constrain(start, center, axis):
-        if axis is None:
-            return center
-        e = np.eye(3)[axis]
-        return start + np.dot(center - start, e) * e
-
-    def _drag_move(self, j, center):
-        drag = self._drag
-        if drag is None or drag["joint"] != j:
-            return
-        target = self._constrain(drag["start"], center, drag["axis"])
-        if drag["axis"] is not None:
-            self.gizmos.set_center(j, target)
-        drag["target"] = target
-        if self.mode == "pose":
-            self.drag_step(j, target)
-        else:
-            rest = self.document.rig.joint_matrices(self.document.rig.rest_pose())
-            heads = rest[:, :3, 3].copy()
-            heads[j] = target
-            self.scene.bones.points[:] = heads
-            self.scene.bones.Modified()
-            self.axes.set_position(target)
-
-    def drag_step(self, j, target):
-        """One pose-mode drag step: IK from the pose at drag start, then FK, skinning and the
-        actors' points updated in place (no render; the caller or VTK renders)."""
-        work = self._drag["work"]
-        work.set_array(self._drag["pose"])
-        drag_joint(self.document.skeleton, work, j, target, self.chain_length,
-                   fk=self.document.rig.joint_matrices)
-        self.document.set_pose(work)
-
-    def _drag_end(self, j):
-        drag, self._drag = self._drag, None
-        self._interacting = False
-        if drag is None:
-            return
-        d = self.document
-        name = d.skeleton.names[j]
-        if self.mode == "pose":
-            d.end_drag(f"Drag {name}")
-            # Snap the sphere onto where the joint really is (it may not reach the mouse).
-            self.gizmos.set_center(j, self.scene.joint_positions[j])
-            self.status(f"Posed {name}")
-        elif "target" in drag and not np.allclose(drag["target"], drag["start"]):
-            self.rebind_moved_joint(j, drag["target"])
-        self.request_render()
-
-    # An arrow handle drag: the selected joint, constrained to the arrow's axis.
-    def _axis_drag_start(self, axis):
-        j = self.document.selection
-        if j is not None:
-            self._drag_start(j, axis=axis)
-
-    def _axis_drag_move(self, axis, target):
-        if self._drag is not None:
-            self._drag_move(self._drag["joint"], target)
-
-    def _axis_drag_end(self, axis):
-        if self._drag is not None:
-            self._drag_end(self._drag["joint"])
-
     def _euler_live(self, j, angles):
         self.document.begin_drag()
         self.document.pose.set_euler(j, angles, degrees=True)
@@ -585,36 +377,6 @@ class MainWindow(QtWidgets.QMainWindow):
     def _reset_selected(self):
         if self.document.selection is not None:
             self.document.reset_joint(self.document.selection)
-
-    # ================================================================== bind mode
-    def rebind_moved_joint(self, j, head):
-        """Move joint ``j``'s rest position to ``head`` and re-bind the skin in a worker."""
-        from ..document import skeleton_with_moved_joint
-
-        d = self.document
-        before = d.rest_state()
-        skeleton = skeleton_with_moved_joint(d.skeleton, j, head)
-        vertices = d.rig.vertices
-        name = d.skeleton.names[j]
-
-        def done(result):
-            indices, weights = result
-            pose = before[2].copy()
-            delta = skeleton.rest_translation - before[0].rest_translation
-            pose[:, :3] += delta  # keep the pose's offsets from rest
-            d.push_rest_edit(f"Move {name} (rest)", before,
-                             d.make_rest_state(skeleton, indices, weights, pose))
-            self.status(f"Moved {name}'s rest position and re-bound the skin "
-                        f"({len(vertices):,} vertices)")
-
-        def cancelled():
-            self._refresh_pose()
-            self.request_render()
-            self.status(f"Re-bind cancelled; {name} keeps its rest position")
-
-        self.run_job(f"Re-binding after moving {name}",
-                     lambda report: weights_in_chunks(vertices, skeleton, report=report),
-                     done, cancelled)
 
     # ================================================================== jobs
     def run_job(self, label, fn, on_done, on_cancel=None):
