@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from builders import chain_skeleton, cylinder_rig
+from builders import chain_skeleton
 from rigedit.model import Pose, SkinBinding, Skeleton, local_to_model, skinning_matrices
 from rigedit.model.skinning import top_k_influences
 

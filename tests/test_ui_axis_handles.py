@@ -1,55 +1,12 @@
 """The selected joint's X/Y/Z arrows are drag handles (real interactor events under Xvfb):
 a drag on an arrow moves the joint along that world axis only, through the same code as a
 sphere drag (edit mode: rest position; pose mode: root translation), as one undo step."""
-import warnings
 
 import numpy as np
 import pytest
 
 pytest.importorskip("pytestqt")
 pytestmark = [pytest.mark.ui, pytest.mark.filterwarnings("error::RuntimeWarning")]
-
-import rigedit  # noqa: E402
-
-_ORIGINAL = {}
-
-
-def _default_rig():
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            return rigedit.load_rig()
-    except (ValueError, OSError):
-        from rigedit.ui.fallback import demo_rig
-
-        return demo_rig()
-
-
-@pytest.fixture(scope="module")
-def rig_template():
-    return _default_rig()
-
-
-@pytest.fixture
-def window(qtbot, rig_template):
-    from threadpoolctl import threadpool_limits
-
-    from rigedit.ui import MainWindow
-
-    rig = rig_template
-    # Every test starts from the bundled rest state (tests edit the rig in place).
-    rig.skeleton, rig.binding = _ORIGINAL.setdefault(id(rig), (rig.skeleton, rig.binding))
-    with threadpool_limits(1):
-        w = MainWindow(rig)
-        qtbot.addWidget(w)
-        w.resize(1100, 750)
-        w.show()
-        qtbot.waitExposed(w)
-        w.plotter.render()
-        yield w
-        errors = list(w.gizmos.errors)
-        w.close()
-    assert errors == [], "exceptions in VTK callbacks:\n" + "\n".join(errors)
 
 
 def _limb_joint(sk):

@@ -1,56 +1,11 @@
 """The editor window under Xvfb: gizmos, drags (widget events and real mouse events), panel
 edits, undo, view modes, bind mode, bad files, screenshot."""
-import os
-import warnings
 
 import numpy as np
 import pytest
 
 pytest.importorskip("pytestqt")
 pytestmark = [pytest.mark.ui, pytest.mark.filterwarnings("error::RuntimeWarning")]
-
-import rigedit  # noqa: E402
-
-
-def _default_rig():
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            return rigedit.load_rig()
-    except (ValueError, OSError):
-        from rigedit.ui.fallback import demo_rig
-
-        return demo_rig()
-
-
-@pytest.fixture(scope="module")
-def rig_template():
-    return _default_rig()
-
-
-@pytest.fixture
-def window(qtbot, rig_template):
-    from threadpoolctl import threadpool_limits
-
-    from rigedit.ui import MainWindow
-
-    rig = rig_template
-    # Every test starts from the bundled rest state (tests edit the rig in place).
-    rig.skeleton, rig.binding = _ORIGINAL.setdefault(id(rig), (rig.skeleton, rig.binding))
-    with threadpool_limits(1):
-        w = MainWindow(rig)
-        qtbot.addWidget(w)
-        w.resize(1100, 750)
-        w.show()
-        qtbot.waitExposed(w)
-        w.plotter.render()
-        yield w
-        errors = list(w.gizmos.errors)
-        w.close()
-    assert errors == [], "exceptions in VTK callbacks:\n" + "\n".join(errors)
-
-
-_ORIGINAL = {}
 
 
 def _limb_joint(sk):

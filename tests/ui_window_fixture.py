@@ -1,0 +1,48 @@
+"""The editor window fixture shared by the UI tests (a real window under Xvfb)."""
+import warnings
+
+import pytest
+
+import rigedit
+
+_ORIGINAL = {}
+
+
+def _default_rig():
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return rigedit.load_rig()
+    except (ValueError, OSError):
+        from rigedit.ui.fallback import demo_rig
+
+        return demo_rig()
+
+
+@pytest.fixture(scope="module")
+def rig_template():
+    return _default_rig()
+
+
+@pytest.fixture
+def window(qtbot, rig_template):
+    """The main window on the default rig, reset to its bundled rest state; fails the test
+    when a VTK callback raised."""
+    from threadpoolctl import threadpool_limits
+
+    from rigedit.ui import MainWindow
+
+    rig = rig_template
+    # Every test starts from the bundled rest state (tests edit the rig in place).
+    rig.skeleton, rig.binding = _ORIGINAL.setdefault(id(rig), (rig.skeleton, rig.binding))
+    with threadpool_limits(1):
+        w = MainWindow(rig)
+        qtbot.addWidget(w)
+        w.resize(1100, 750)
+        w.show()
+        qtbot.waitExposed(w)
+        w.plotter.render()
+        yield w
+        errors = list(w.gizmos.errors)
+        w.close()
+    assert errors == [], "exceptions in VTK callbacks:\n" + "\n".join(errors)
