@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -160,6 +161,7 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
     if clip is not None:
         clip = clip.copy()   # the editor may change its clip while we render
 
+    _use_egl_without_display()
     plotter = pv.Plotter(off_screen=True, window_size=(width, height))
     writer = None
     try:
@@ -208,6 +210,15 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         if writer is not None:
             writer.abort()
         plotter.close()
+
+
+def _use_egl_without_display():
+    """With no X display (a server, CI without Xvfb), VTK first tries X, prints a warning and
+    then falls back; asking for its EGL window directly renders the same frames silently.
+    Only set when nothing chose otherwise."""
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
+                                                 or os.environ.get("WAYLAND_DISPLAY")):
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 
 def _grid_floor(plotter, behind="#c3c9d0"):
