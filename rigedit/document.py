@@ -70,6 +70,28 @@ class UndoStack:
         self._undone.clear()
         self._notify()
 
+    def amend(self, command, label=None, execute=True):
+        """Run ``command`` and fold it into the last step, so one undo reverts both (an
+        auto-key written after the pose edit that caused it). Pushes it alone when the stack
+        is empty."""
+        if not self._done:
+            return self.push(command, execute)
+        if execute:
+            command.do()
+        last = self._done.pop()
+
+        def do():
+            last.do()
+            command.do()
+
+        def undo():
+            command.undo()
+            last.undo()
+
+        self._done.append(Command(label or f"{last.label} + {command.label}", do, undo))
+        self._undone.clear()
+        self._notify()
+
     def undo(self):
         """Revert the last command; returns it, or None when there is nothing to undo."""
         if not self._done:

@@ -142,3 +142,17 @@ def test_rest_edit_undo_restores_skeleton_and_weights(doc):
     np.testing.assert_array_equal(doc.rig.binding.weights, w_before)
     doc.redo()
     assert doc.skeleton is new
+
+
+def test_amend_folds_a_command_into_the_last_step():
+    from rigedit.document import Command, UndoStack
+
+    log = []
+    stack = UndoStack()
+    stack.push(Command("a", lambda: log.append("do a"), lambda: log.append("undo a")))
+    stack.amend(Command("b", lambda: log.append("do b"), lambda: log.append("undo b")))
+    assert len(stack) == 1 and stack.undo_label == "a + b"
+    stack.undo()
+    assert log == ["do a", "do b", "undo b", "undo a"]
+    stack.redo()
+    assert log[-2:] == ["do a", "do b"]

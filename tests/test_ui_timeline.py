@@ -176,9 +176,16 @@ def test_auto_key_writes_keys_when_posing(window):
     doc.set_joint_euler("tail", [0, 0, 25])
     assert 0.2 in tl.clip.key_times("tail")
     assert tl.clip.sample(0.2).allclose(doc.pose)
-    assert doc.undo_stack.undo_label.startswith("Auto-key")
-    doc.undo()                                          # the key goes first
+    assert "auto-key tail" in doc.undo_stack.undo_label
+    steps = len(doc.undo_stack)
+    doc.undo()                       # one step takes back the pose edit and its key
     assert len(tl.clip.key_times("tail")) == 0
+    assert np.allclose(doc.pose.get_euler("tail", degrees=True), 0, atol=1e-9)
+    assert len(doc.undo_stack) == steps - 1
+    doc.redo()
+    assert 0.2 in tl.clip.key_times("tail")
+    assert np.allclose(doc.pose.get_euler("tail", degrees=True), [0, 0, 25], atol=1e-6)
+    doc.undo()
     tl.set_auto_key(False)
     doc.set_joint_euler("tail", [0, 0, 10])
     assert len(tl.clip.key_times("tail")) == 0

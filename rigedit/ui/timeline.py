@@ -318,10 +318,13 @@ class TimelineDock(QtWidgets.QDockWidget):
         self.time_label.setText(f"{t:6.2f} s   frame {t * self.fps:5.1f}")
 
     # ================================================================== undoable edits
-    def _push(self, command):
+    def _push(self, command, amend=False):
         self._own_push = True
         try:
-            self.document.push(command)
+            if amend:   # fold into the document's last step (auto-key after a pose edit)
+                self.document.undo_stack.amend(command)
+            else:
+                self.document.push(command)
         finally:
             self._own_push = False
             self._stack_len = len(self.document.undo_stack)
@@ -330,9 +333,9 @@ class TimelineDock(QtWidgets.QDockWidget):
         self._resample = resample
         self.document.emit("clip", name=self.document.current_clip)
 
-    def _edit_clip(self, label, change, resample=True, clip=None):
-        """Run ``change(clip)`` as one undo step; nothing is recorded when it changed
-        nothing. Returns what ``change`` returned."""
+    def _edit_clip(self, label, change, resample=True, clip=None, amend=False):
+        """Run ``change(clip)`` as one undo step (folded into the last one with ``amend``);
+        nothing is recorded when it changed nothing. Returns what ``change`` returned."""
         clip = clip or self.clip
         if clip is None:
             return None
@@ -352,14 +355,14 @@ class TimelineDock(QtWidgets.QDockWidget):
             clip.restore(before)
             self._clip_changed(True)
 
-        self._push(Command(label, do, undo))
+        self._push(Command(label, do, undo), amend=amend)
         return result
 
     def _scope(self, all_joints):
         name = self._joint_name()
         return None if all_joints or name is None else [name]
 
-    def insert_key(self, all_joints=False, joints=None, label=None):
+    def insert_key(self, all_joints=False, joints=None, label=None, amend=False):
         """Key the selected joint (every joint when ``all_joints`` or nothing is selected) at
         the current time from the current pose. Creates a clip when there is none."""
         if self.clip is None:
@@ -369,7 +372,7 @@ class TimelineDock(QtWidgets.QDockWidget):
         what = "all joints" if joints is None else ", ".join(joints)
         return self._edit_clip(label or f"Key {what} at {t:.2f}s",
                                lambda c: c.key_pose(self.document.pose, t, joints),
-                               resample=False)
+                               resample=False, amend=amend)
 
     def _near_key(self, joints, t=None):
         """The key time within half a frame of ``t`` (the current time), or None."""
@@ -491,7 +494,10 @@ class TimelineDock(QtWidgets.QDockWidget):
                 and self.document.mode == "pose" and not self.document.dragging):
             joints = self._changed_joints()
             if joints:
-                self.insert_key(joints=joints, label=f"Auto-key {', '.join(joints)}")
+                # one undo step for the pose edit and its keys, as the user made one edit
+                last = self.document.undo_stack.undo_label
+                self.insert_key(joints=joints, amend=True,
+                                label=f"{last} + auto-key {', '.join(joints)}")
 
     # ------------------------------------------------------------------ clips
     def _edit_clips(self, label, change):
