@@ -188,3 +188,15 @@ def test_atomic_write_gives_normal_file_permissions(tmp_path):
         assert (tmp_path / "old.json").stat().st_mode & 0o777 == 0o640
     finally:
         os.umask(umask)
+
+
+def test_elk_skeleton_parents_from_hierarchy_when_joints_omit_them(tmp_path):
+    p = tmp_path / "skeleton.json"
+    p.write_text(json.dumps({
+        "joints": [{"name": "b", "head": [0, 0, 1], "tail": [0, 0, 2]},
+                   {"name": "a", "head": [0, 0, 0], "tail": [0, 0, 1]}],
+        "bones": ["a", "b"], "hierarchy": {"b": "a"}}))
+    sk, meta = load_skeleton(p)
+    assert meta["format"] == "elk"
+    assert sk.names == ["a", "b"] and list(sk.parents) == [-1, 0]
+    assert np.allclose(sk.rest_translation[1], [0, 0, 1])

@@ -71,11 +71,13 @@ def skeleton_from_heads(names, parent_names, heads, tails=None, deform=None):
 
 def _load_elk(path, data):
     joints = require(path, data, "joints", list)
+    hierarchy = data.get("hierarchy") if isinstance(data.get("hierarchy"), dict) else {}
     names, parents, heads, tails = [], [], [], []
     for i, j in enumerate(joints):
         name = require(path, j, "name", str, f" in joint {i}")
         names.append(name)
-        parent = j.get("parent")
+        # The joint's own "parent" wins; the file's {child: parent} map fills in when absent.
+        parent = j["parent"] if "parent" in j else hierarchy.get(name)
         if parent is not None and not isinstance(parent, str):
             raise RigFileError(path, f"joint {name!r}: expected 'parent' to be a name or null, "
                                      f"got {parent!r}")
