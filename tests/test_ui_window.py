@@ -7,13 +7,7 @@ import pytest
 pytest.importorskip("pytestqt")
 pytestmark = [pytest.mark.ui, pytest.mark.filterwarnings("error::RuntimeWarning")]
 
-
-def _limb_joint(sk):
-    """A joint two below a non-branching chain (a lower leg), for drag tests."""
-    for name in ("fore_cannon_L", "front_foot_L", "hind_cannon_L"):
-        if name in sk.index:
-            return sk.index[name]
-    return len(sk) - 1
+from ui_window_fixture import limb_joint as _limb_joint  # noqa: E402
 
 
 def _moved_and_still(rig, chain_top):

@@ -46,3 +46,11 @@ def window(qtbot, rig_template):
         errors = list(w.gizmos.errors)
         w.close()
     assert errors == [], "exceptions in VTK callbacks:\n" + "\n".join(errors)
+
+
+def limb_joint(sk):
+    """A joint two below a non-branching chain (a lower leg), for drag tests."""
+    for name in ("fore_cannon_L", "front_foot_L", "hind_cannon_L"):
+        if name in sk.index:
+            return sk.index[name]
+    return len(sk) - 1
