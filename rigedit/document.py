@@ -18,6 +18,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .model.skeleton import Skeleton
+from .model.skinning import SkinBinding
+
 __all__ = ["Command", "UndoStack", "Document", "mirror_name", "mirror_map", "mirror_pose",
            "skeleton_with_moved_joint"]
 
@@ -356,8 +359,6 @@ class Document:
 
     def make_rest_state(self, skeleton, indices, weights, pose=None):
         """A state for :meth:`push_rest_edit` from new weights (validated here)."""
-        from .model.skinning import SkinBinding
-
         binding = SkinBinding(self.rig.vertices, indices, weights, len(skeleton))
         return (skeleton, binding, self.pose_snapshot() if pose is None else np.array(pose))
 
@@ -410,11 +411,7 @@ def mirror_pose(pose, mirror, names, axis, source="L"):
     qflip = -flip  # quaternion vector part under a reflection: -(sign) of each axis
     for i, name in enumerate(names):
         j = mirror[i]
-        if j == i:
-            continue
-        side = mirror_name(name)
-        is_source = _side_of(name) == source
-        if not is_source or side is None:
+        if j == i or _side_of(name) != source:
             continue
         pose.translation[j] = pose.translation[i] * flip
         q = pose.rotation[i].copy()
@@ -428,8 +425,7 @@ def _side_of(name):
     m = mirror_name(name)
     if m is None:
         return None
-    for left, right in (("_L", "_R"), ("_l", "_r"), (".L", ".R"), (".l", ".r"),
-                        ("Left", "Right"), ("left", "right"), ("L_", "R_"), ("l_", "r_")):
+    for left, right in _MIRROR_PAIRS:
         if (left in name and right in m) and not (right in name and left in m):
             return "L"
         if right in name and left in m:
@@ -452,8 +448,6 @@ def skeleton_with_moved_joint(skeleton, joint, head):
     -------
     Skeleton
     """
-    from .model.skeleton import Skeleton
-
     head = np.asarray(head, dtype=np.float64).reshape(3)
     if not np.all(np.isfinite(head)):
         raise ValueError(f"expected a finite joint position, got {head}")

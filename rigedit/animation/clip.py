@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.pose import Pose
-from .interpolate import MODES, ROTATION_MODES, VECTOR_MODES, catmull_rom_tangents, sample_track
+from .interpolate import ROTATION_MODES, VECTOR_MODES, catmull_rom_tangents, sample_track
 
 __all__ = ["CHANNELS", "Track", "Clip"]
 
@@ -87,8 +87,6 @@ class Track:
 
     def key_index(self, t, tol=KEY_TOLERANCE):
         """Index of the key within ``tol`` seconds of ``t``, or None."""
-        if len(self.times) == 0:
-            return None
         i = int(np.argmin(np.abs(self.times - t)))
         return i if abs(self.times[i] - t) <= tol else None
 
@@ -156,13 +154,13 @@ class Clip:
         self.skeleton = skeleton
         self.tracks = {}
         self.loop = bool(loop)
+        self.revision = 0
         for (joint, channel), track in (tracks or {}).items():
             self.set_track(joint, channel, track)
         last = max((tr.times[-1] for tr in self.tracks.values()), default=0.0)
         self.duration = float(last if duration is None else duration)
         if self.duration < 0 or not np.isfinite(self.duration):
             raise ValueError(f"clip {self.name!r}: expected a duration >= 0, got {duration}")
-        self.revision = 0
 
     def set_track(self, joint, channel, track):
         """Add or replace a track; ``KeyError`` for a joint the skeleton lacks."""
@@ -171,7 +169,7 @@ class Clip:
             raise ValueError(f"track for {joint!r}: expected channel {channel!r}, "
                              f"got {track.channel!r}")
         self.tracks[(joint, channel)] = track
-        self.revision = getattr(self, "revision", 0) + 1
+        self._touch()
 
     def remove_track(self, joint, channel):
         if self.tracks.pop((joint, channel), None) is not None:

@@ -14,6 +14,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .kinematics import local_to_model
+
 __all__ = ["fabrik", "aim_joint", "ik_chain", "solve_chain", "drag_joint"]
 
 
@@ -45,7 +47,7 @@ def fabrik(positions, target, tolerance=1e-6, max_iterations=30):
     dist = np.linalg.norm(to_target)
     if dist >= lengths.sum():
         # Out of reach: stretch straight towards the target.
-        direction = to_target / dist if dist > 1e-12 else _any_direction(p)
+        direction = to_target / dist if dist > 1e-12 else _unit(p[-1] - p[0])
         p[1:] = base + np.cumsum(lengths)[:, None] * direction
         return p
     for _ in range(max_iterations):
@@ -63,11 +65,6 @@ def fabrik(positions, target, tolerance=1e-6, max_iterations=30):
 def _unit(v):
     n = np.linalg.norm(v)
     return v / n if n > 1e-12 else np.array([0.0, 1.0, 0.0])
-
-
-def _any_direction(p):
-    d = p[-1] - p[0]
-    return _unit(d)
 
 
 def _rotation_between(a, b):
@@ -175,11 +172,12 @@ def drag_joint(skeleton, pose, joint, target, chain_length=1, fk=None):
     target : (3,) float
     chain_length : int
     fk : callable, optional
-        ``fk(pose) -> (J, 4, 4)``; ``skeleton.forward(pose.local_matrices())`` by default.
+        ``fk(pose) -> (J, 4, 4)``; :func:`~rigedit.model.kinematics.local_to_model` by
+        default.
     """
     if fk is None:
         def fk(p):
-            return skeleton.forward(p.local_matrices())
+            return local_to_model(skeleton, p)
     target = np.asarray(target, dtype=np.float64).reshape(3)
     parent = skeleton.parents[joint]
     if parent < 0:

@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pyvista as pv
 import vtk
-from vtk.util.numpy_support import numpy_to_vtk
+
+from ..model.kinematics import skinning_matrices
 
 __all__ = ["RigScene", "up_vector", "front_vector", "faces_to_vtk"]
 
@@ -196,13 +197,11 @@ class RigScene:
         """Same as :meth:`update` from model matrices already computed; ``skin=False``
         moves the bones only (the mesh keeps its points)."""
         if skin:
-            palette = np.matmul(model, self.rig.skeleton.inverse_bind_matrices)
-            verts = self.rig.binding.skin(palette)
-            pts = self.mesh.points
-            pts[:] = verts
+            palette = skinning_matrices(self.rig.skeleton, model)
+            self.mesh.points[:] = self.rig.binding.skin(palette)
             self.mesh.GetPoints().Modified()
             self.mesh.Modified()
-        self.joint_positions = model[:, :3, 3].copy()
+        self.joint_positions[:] = model[:, :3, 3]
         self.bones.points[:] = self.joint_positions
         self.bones.GetPoints().Modified()
         self.bones.Modified()

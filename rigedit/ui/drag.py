@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..document import skeleton_with_moved_joint
 from ..model.ik import drag_joint
 from .jobs import weights_in_chunks
 
@@ -100,8 +101,6 @@ class DragMixin:
     # ================================================================== bind mode
     def rebind_moved_joint(self, j, head):
         """Move joint ``j``'s rest position to ``head`` and re-bind the skin in a worker."""
-        from ..document import skeleton_with_moved_joint
-
         d = self.document
         before = d.rest_state()
         skeleton = skeleton_with_moved_joint(d.skeleton, j, head)

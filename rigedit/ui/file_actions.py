@@ -9,6 +9,7 @@ from pathlib import Path
 from PyQt5 import QtWidgets
 
 from ..io.atomic import write_json
+from ..io.rig_folder import load_rig_folder, save_rig_folder
 from ..io.skeleton_json import save_skeleton
 from ..io.weights_npz import load_weights, save_weights
 from .jobs import weights_in_chunks
@@ -30,8 +31,6 @@ def pose_to_dict(pose):
 
 
 def _load_folder(path):
-    from ..io.rig_folder import load_rig_folder
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # "weights computed" is expected, not an error
         return load_rig_folder(path)
@@ -105,43 +104,37 @@ class FileActions:
         path = path or QtWidgets.QFileDialog.getExistingDirectory(self.w, "Save rig into folder")
         return self.save_to(path) if path else None
 
+    def _attempt(self, title, action, done):
+        """Run ``action()``; on bad input or an OS error show one message titled ``title``
+        and return False, else show ``done`` in the status bar and return True."""
+        try:
+            action()
+        except (ValueError, OSError) as exc:
+            self.w.error(title, str(exc))
+            return False
+        self.w.status(done)
+        return True
+
     def save_to(self, path):
         """Write the rig folder (each file atomically); the status bar says where."""
-        from ..io.rig_folder import save_rig_folder
-
         rig = self.doc.rig
-        try:
-            save_rig_folder(path, rig)
-        except (ValueError, OSError) as exc:
-            self.w.error("Save rig", str(exc))
+        if not self._attempt("Save rig", lambda: save_rig_folder(path, rig),
+                             f"Saved {rig.name} to {path}"):
             return False
         rig.path = Path(path)
-        self.w.status(f"Saved {rig.name} to {path}")
         return True
 
     def export_pose(self, path=None):
         path = path or self._ask_save("Export pose", "pose.json", "JSON (*.json)")
-        if not path:
-            return False
-        try:
-            write_json(path, pose_to_dict(self.doc.pose))
-        except (ValueError, OSError) as exc:
-            self.w.error("Export pose", str(exc))
-            return False
-        self.w.status(f"Exported the pose to {path}")
-        return True
+        return bool(path) and self._attempt(
+            "Export pose", lambda: write_json(path, pose_to_dict(self.doc.pose)),
+            f"Exported the pose to {path}")
 
     def export_skeleton(self, path=None):
         path = path or self._ask_save("Export skeleton", "skeleton.json", "JSON (*.json)")
-        if not path:
-            return False
-        try:
-            save_skeleton(path, self.doc.skeleton, up=self.doc.rig.up)
-        except (ValueError, OSError) as exc:
-            self.w.error("Export skeleton", str(exc))
-            return False
-        self.w.status(f"Exported the skeleton to {path}")
-        return True
+        return bool(path) and self._attempt(
+            "Export skeleton", lambda: save_skeleton(path, self.doc.skeleton, up=self.doc.rig.up),
+            f"Exported the skeleton to {path}")
 
     # ------------------------------------------------------------------ weights
     def load_weights(self, path=None):
@@ -150,27 +143,20 @@ class FileActions:
         if not path:
             return False
         rig = self.doc.rig
-        try:
+
+        def load():
             indices, weights = load_weights(path, rig.skeleton, len(rig.vertices))
             self.doc.set_weights(indices, weights, label=f"Load weights {Path(path).name}")
-        except (ValueError, OSError) as exc:
-            self.w.error("Load weights", str(exc))
-            return False
-        self.w.status(f"Loaded weights from {path}")
-        return True
+
+        return self._attempt("Load weights", load, f"Loaded weights from {path}")
 
     def save_weights(self, path=None):
         path = path or self._ask_save("Save weights", "weights.npz", "Weights (*.npz)")
-        if not path:
-            return False
         b = self.doc.rig.binding
-        try:
-            save_weights(path, b.indices, b.weights, self.doc.skeleton.names)
-        except (ValueError, OSError) as exc:
-            self.w.error("Save weights", str(exc))
-            return False
-        self.w.status(f"Saved weights to {path}")
-        return True
+        return bool(path) and self._attempt(
+            "Save weights", lambda: save_weights(path, b.indices, b.weights,
+                                                 self.doc.skeleton.names),
+            f"Saved weights to {path}")
 
     def recompute_weights(self):
         """Recompute the weights off the UI thread (progress, cancel); one undo step."""
@@ -189,13 +175,5 @@ class FileActions:
 
     def save_screenshot(self, path=None):
         path = path or self._ask_save("Save screenshot", "rigedit.png", "PNG (*.png)")
-        if not path:
-            return False
-        try:
-            self.w.screenshot(path)
-        except OSError as exc:
-            self.w.error("Screenshot", str(exc))
-            return False
-        self.w.status(f"Saved a screenshot to {path}")
-        return True
-
+        return bool(path) and self._attempt("Screenshot", lambda: self.w.screenshot(path),
+                                            f"Saved a screenshot to {path}")

@@ -9,8 +9,9 @@ from __future__ import annotations
 import threading
 import traceback
 
-import numpy as np
 from PyQt5 import QtCore
+
+from ..model.weights import compute_weights
 
 __all__ = ["Cancelled", "Job", "weights_in_chunks"]
 
@@ -69,27 +70,13 @@ class Job(QtCore.QThread):
             self.succeeded.emit(result)
 
 
-def weights_in_chunks(vertices, skeleton, method="idw", report=None, chunk=4096):
-    """Compute skin weights a block of vertices at a time so progress shows and a cancel is
-    honoured between blocks (each vertex's weights depend on it alone for the ``idw`` method).
+def weights_in_chunks(vertices, skeleton, method="idw", report=None):
+    """Compute skin weights with progress: ``report(fraction)`` is called after each block
+    of vertices, and its :class:`Cancelled` stops the work between blocks.
 
     Returns
     -------
     indices : (V, K) int32
     weights : (V, K) float64
     """
-    from ..model.weights import compute_weights
-
-    if method != "idw":  # global methods (bone heat) cannot be split by vertex
-        if report:
-            report(None)
-        return compute_weights(vertices, skeleton, method)
-    parts_i, parts_w = [], []
-    n = len(vertices)
-    for lo in range(0, n, chunk):
-        i, w = compute_weights(vertices[lo:lo + chunk], skeleton, method)
-        parts_i.append(i)
-        parts_w.append(w)
-        if report:
-            report(min(1.0, (lo + chunk) / n))
-    return np.vstack(parts_i), np.vstack(parts_w)
+    return compute_weights(vertices, skeleton, method, progress=report)
