@@ -22,6 +22,20 @@ ACTIVE_COLOR = (1.0, 0.95, 0.35)  # while being dragged
 AXIS_COLORS = ((0.90, 0.25, 0.25), (0.30, 0.80, 0.30), (0.30, 0.50, 0.95))
 
 
+def _record_failure(errors, what):
+    """Keep the traceback of a failed VTK callback in ``errors`` and warn with it."""
+    tb = traceback.format_exc()
+    errors.append(tb)
+    warnings.warn(f"{what} callback failed:\n{tb}", RuntimeWarning, stacklevel=2)
+
+
+def world_to_display(renderer, world):
+    """(3,) display coordinates (pixels x, y and depth) of a world point in ``renderer``."""
+    renderer.SetWorldPoint(*np.asarray(world, dtype=float), 1.0)
+    renderer.WorldToDisplay()
+    return np.array(renderer.GetDisplayPoint())
+
+
 def gizmo_radius(rig):
     """Joint sphere radius from the character's size and its bone lengths (model units)."""
     lo, hi = rig.bounds()
@@ -144,9 +158,7 @@ class JointGizmos:
             try:
                 fn(j, widget)
             except Exception:  # noqa: BLE001 - VTK would swallow it; keep it visible
-                tb = traceback.format_exc()
-                self.errors.append(tb)
-                warnings.warn(f"joint gizmo callback failed:\n{tb}", RuntimeWarning, stacklevel=1)
+                _record_failure(self.errors, "joint gizmo")
         return callback
 
     def _start(self, j, widget):
@@ -193,10 +205,8 @@ class JointGizmos:
 
     def display_position(self, j, renderer=None):
         """(x, y) display (pixel) coordinates of joint ``j``'s sphere centre."""
-        ren = renderer or self.widgets[j].GetCurrentRenderer()
-        ren.SetWorldPoint(*self.center(j), 1.0)
-        ren.WorldToDisplay()
-        x, y, _ = ren.GetDisplayPoint()
+        x, y, _ = world_to_display(renderer or self.widgets[j].GetCurrentRenderer(),
+                                   self.center(j))
         return x, y
 
     def remove(self):
@@ -310,10 +320,7 @@ class AxisHandles:
 
     def display_point(self, world):
         """(x, y, z) display coordinates of a world point in the handles' renderer."""
-        ren = self.renderer
-        ren.SetWorldPoint(*np.asarray(world, dtype=float), 1.0)
-        ren.WorldToDisplay()
-        return np.array(ren.GetDisplayPoint())
+        return world_to_display(self.renderer, world)
 
     def ray(self, x, y):
         """The mouse ray through display pixel (x, y): origin on the near plane and unit
@@ -403,10 +410,7 @@ class AxisHandles:
                 if fn(obj):
                     obj.GetCommand(self._tag(event)).SetAbortFlag(1)
             except Exception:  # noqa: BLE001 - VTK would swallow it; keep it visible
-                tb = traceback.format_exc()
-                self.errors.append(tb)
-                warnings.warn(f"axis handle callback failed:\n{tb}", RuntimeWarning,
-                              stacklevel=1)
+                _record_failure(self.errors, "axis handle")
         return callback
 
     def _tag(self, event):

@@ -18,7 +18,7 @@ import pyvista as pv
 
 from ..errors import RigFileError
 from ..io.atomic import temp_beside
-from .scene import RigScene
+from .scene import RigScene, turn_about, up_vector
 
 __all__ = ["record_clip", "frame_times", "camera_state", "apply_camera", "VIDEO_SUFFIXES",
            "RecordingCancelled"]
@@ -187,15 +187,10 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
             if clip is not None:
                 clip.sample(t, out=pose)
             model = scene.update(pose)
-            shift = np.zeros(3)
-            if follow_root:
-                shift = model[0, :3, 3] - root0
-                shift -= np.dot(shift, up) * up  # horizontal part only
+            shift = _horizontal(model[0, :3, 3] - root0, up) if follow_root else np.zeros(3)
             rel = base_pos - base_focal
             if orbit:
-                a = np.radians(orbit * i / max(len(times), 1))
-                rel = (rel * np.cos(a) + np.cross(up, rel) * np.sin(a)
-                       + up * np.dot(up, rel) * (1 - np.cos(a)))
+                rel = turn_about(rel, up, orbit * i / max(len(times), 1))
             plotter.camera.focal_point = base_focal + shift
             plotter.camera.position = base_focal + shift + rel
             plotter.reset_camera_clipping_range()
@@ -241,6 +236,11 @@ def _grid_floor(plotter, behind="#c3c9d0"):
     prop.SetSpecular(0.0)
 
 
+def _horizontal(offset, up):
+    """The part of ``offset`` (3,) perpendicular to the unit ``up`` axis."""
+    return offset - np.dot(offset, up) * up
+
+
 def swept_points(rig, clip, times, samples=12, per_frame=3000):
     """Vertices the clip sweeps over the recorded times, with the root's horizontal motion
     taken out (the camera follows it), to frame the whole motion.
@@ -252,16 +252,14 @@ def swept_points(rig, clip, times, samples=12, per_frame=3000):
     step = max(1, len(rig.vertices) // per_frame)
     if clip is None:
         return rig.vertices[::step]
-    up = np.array([0.0, 1.0, 0.0]) if rig.up == "y" else np.array([0.0, 0.0, 1.0])
+    up = up_vector(rig.up)
     pose = rig.rest_pose()
     pts, root0 = [], None
     for t in np.linspace(times[0], times[-1], min(samples, len(times))):
         clip.sample(t, out=pose)
         root = rig.joint_matrices(pose)[0, :3, 3]
         root0 = root if root0 is None else root0
-        shift = root - root0
-        shift -= np.dot(shift, up) * up
-        pts.append(rig.skin(pose)[::step] - shift)
+        pts.append(rig.skin(pose)[::step] - _horizontal(root - root0, up))
     return np.concatenate(pts)
 
 

@@ -8,10 +8,11 @@ from __future__ import annotations
 import numpy as np
 import pyvista as pv
 import vtk
+from scipy.spatial.transform import Rotation
 
 from ..model.kinematics import skinning_matrices
 
-__all__ = ["RigScene", "up_vector", "front_vector", "faces_to_vtk"]
+__all__ = ["RigScene", "up_vector", "front_vector", "faces_to_vtk", "turn_about"]
 
 MESH_COLOR = "#c9b79c"
 BONE_COLOR = "#2f6fd6"
@@ -29,6 +30,11 @@ def front_vector(up):
     elk project) face -Y.
     """
     return np.array([0.0, 0.0, 1.0]) if up == "y" else np.array([0.0, -1.0, 0.0])
+
+
+def turn_about(vector, axis, degrees):
+    """``vector`` (3,) turned by ``degrees`` about the unit ``axis`` (right-handed)."""
+    return Rotation.from_rotvec(np.radians(degrees) * np.asarray(axis, float)).apply(vector)
 
 
 def _nice_cell(size):
@@ -235,9 +241,7 @@ class RigScene:
         direction = {"front": self.front, "back": -self.front, "side": -side,
                      "top": self.up}[name]
         if name != "top":
-            a = np.radians(angle)
-            # Rodrigues about the up axis (direction is perpendicular to it here).
-            direction = (direction * np.cos(a) + np.cross(self.up, direction) * np.sin(a))
+            direction = turn_about(direction, self.up, angle)
             direction = direction + 0.15 * self.up  # a little from above, as a person sees it
         direction = direction / np.linalg.norm(direction)
         cam_up = -self.front if name == "top" else self.up
