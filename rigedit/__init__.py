@@ -16,8 +16,8 @@ from .errors import RigFileError
 from .model import Pose, Skeleton, SkinBinding
 from .rig import Rig
 
-__all__ = ["load_rig", "resolve_rig_path", "BUNDLED", "ASSETS_DIR", "Rig", "Skeleton", "Pose",
-           "Clip", "Track", "SkinBinding", "RigFileError"]
+__all__ = ["load_rig", "save_rig", "resolve_rig_path", "BUNDLED", "ASSETS_DIR", "Rig",
+           "Skeleton", "Pose", "Clip", "Track", "SkinBinding", "RigFileError"]
 __version__ = "0.1.0"
 
 #: Where the bundled characters live (the repository's assets/ folder, or $RIGEDIT_ASSETS).
@@ -35,15 +35,23 @@ def resolve_rig_path(rig=None):
     return Path(rig)
 
 
-def load_rig(rig=None, weights_method="idw"):
-    """Load a rig folder, or a bundled character by name (``quadruped``, the default, or
-    ``humanoid``).
+def load_rig(rig=None, weights_method="idw", scale=None):
+    """Load a rig: a bundled name (``quadruped``, the default, or ``humanoid``), a rig folder,
+    a ``.glb``/``.gltf`` file or a ``.bvh`` file (see :func:`rigedit.io.load.load_rig`).
 
     Raises
     ------
     RigFileError
         When a file is missing or malformed; the message names the file.
     """
-    from .io.rig_folder import load_rig_folder
+    from .io.load import load_rig as _load_rig
 
-    return load_rig_folder(resolve_rig_path(rig), weights_method=weights_method)
+    return _load_rig(rig, weights_method=weights_method, scale=scale)
+
+
+def save_rig(rig, path, clips=None):
+    """Save a rig; the format follows the path (a folder, .glb, .gltf, .bvh). See
+    :func:`rigedit.io.save.save_rig`."""
+    from .io.save import save_rig as _save_rig
+
+    return _save_rig(rig, path, clips=clips)

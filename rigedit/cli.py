@@ -21,19 +21,19 @@ class UsageError(Exception):
     """Bad input that is not about a file (an unknown clip, a bad option value)."""
 
 
-def _load(rig_arg, method="idw"):
+def _load(rig_arg, method="idw", scale=None):
     import rigedit
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        rig = rigedit.load_rig(rig_arg, weights_method=method)
+        rig = rigedit.load_rig(rig_arg, weights_method=method, scale=scale)
     for w in caught:  # computed weights, skipped joints: worth a line, not a traceback
         print(f"rigedit: warning: {w.message}", file=sys.stderr)
     return rig
 
 
 def cmd_info(args):
-    rig = _load(args.rig)
+    rig = _load(args.rig, scale=args.scale)
     sk = rig.skeleton
     lo, hi = rig.bounds()
     rows = [("name", rig.name), ("path", rig.path), ("vertices", len(rig.vertices)),
@@ -49,7 +49,7 @@ def cmd_info(args):
 
 
 def cmd_list(args):
-    rig = _load(args.rig)
+    rig = _load(args.rig, scale=args.scale)
     for name in sorted(rig.clips):
         clip = rig.clips[name]
         print(f"{name}\t{clip.duration:.3f}s\t{'loop' if clip.loop else 'once'}")
@@ -62,7 +62,7 @@ def cmd_weights(args):
 
     if not str(args.output).endswith(".npz"):
         raise UsageError(f"{args.output}: expected an output file name ending in .npz")
-    rig = _load(args.rig)
+    rig = _load(args.rig, scale=args.scale)
     t0 = time.perf_counter()
     idx, w = compute_weights(rig.vertices, rig.skeleton, args.method, args.max_influences)
     dt = time.perf_counter() - t0
@@ -88,7 +88,7 @@ def cmd_render(args):
         raise UsageError(f"--fps: expected a positive number, got {args.fps}")
     if args.duration is not None and args.duration <= 0:
         raise UsageError(f"--duration: expected a positive number, got {args.duration}")
-    rig = _load(args.rig)
+    rig = _load(args.rig, scale=args.scale)
     if args.clip not in rig.clips:
         raise UsageError(f"{rig.path}: unknown clip {args.clip!r}; clips: "
                          f"{', '.join(sorted(rig.clips)) or 'none'}")
@@ -119,22 +119,43 @@ def cmd_render(args):
     return 0
 
 
+def cmd_export(args):
+    import rigedit
+
+    rig = _load(args.rig, scale=args.scale)
+    rigedit.save_rig(rig, args.output, clips=args.clip)
+    clips = args.clip or sorted(rig.clips)
+    if Path(args.output).suffix.lower() == ".bvh":
+        clips = clips[:1]
+    print(f"wrote {Path(args.output).resolve()}: {len(rig.skeleton)} joints, "
+          f"{len(rig.vertices)} vertices, clips: {' '.join(clips) or '-'}")
+    return 0
+
+
+def _scale_option(s):
+    s.add_argument("--scale", type=float, default=None, metavar="M",
+                   help="metres per file unit of a .bvh RIG (default: guessed from its height)")
+
+
 def build_parser():
     p = argparse.ArgumentParser(prog="rigedit", description="Rig editor for 3D characters: "
-                                "headless jobs. RIG is a rig folder or a bundled name "
-                                "(quadruped, the default, or humanoid).")
+                                "headless jobs. RIG is a rig folder, a .glb/.gltf/.bvh file or a "
+                                "bundled name (quadruped, the default, or humanoid).")
     sub = p.add_subparsers(dest="command", required=True)
     s = sub.add_parser("info", help="print facts about a rig as key: value lines")
     s.add_argument("rig", nargs="?")
+    _scale_option(s)
     s.set_defaults(func=cmd_info)
     s = sub.add_parser("list", help="list a rig's clips and durations")
     s.add_argument("rig", nargs="?")
+    _scale_option(s)
     s.set_defaults(func=cmd_list)
     s = sub.add_parser("weights", help="compute skinning weights into a .npz file")
     s.add_argument("rig", nargs="?")
     s.add_argument("--method", default="idw", help="weights method (default idw)")
     s.add_argument("--max-influences", type=int, default=4, metavar="K")
     s.add_argument("-o", "--output", required=True, metavar="FILE.npz")
+    _scale_option(s)
     s.set_defaults(func=cmd_weights)
     s = sub.add_parser("render", help="render a clip off-screen to MP4 or GIF")
     s.add_argument("clip")
@@ -149,7 +170,15 @@ def build_parser():
     s.add_argument("--size", default="1280x720", metavar="WxH")
     s.add_argument("--skeleton", action="store_true", help="draw the bones too")
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    _scale_option(s)
     s.set_defaults(func=cmd_render)
+    s = sub.add_parser("export", help="write a rig as glTF (.glb/.gltf), BVH or a rig folder")
+    s.add_argument("rig")
+    s.add_argument("-o", "--output", required=True, metavar="OUT.glb|OUT.gltf|OUT.bvh|FOLDER")
+    s.add_argument("--clip", action="append", default=None, metavar="NAME",
+                   help="a clip to write (repeat for several; default all, BVH: the first)")
+    _scale_option(s)
+    s.set_defaults(func=cmd_export)
     return p
 
 

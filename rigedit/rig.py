@@ -85,6 +85,13 @@ class Rig:
         axis = 1 if self.up == "y" else 2
         return float(hi[axis] - lo[axis]) or float(np.linalg.norm(hi - lo)) or 1.0
 
+    def save(self, path, clips=None):
+        """Write the rig; the format follows ``path`` (a folder, .glb, .gltf or .bvh), see
+        :func:`rigedit.io.save.save_rig`."""
+        from .io.save import save_rig
+
+        return save_rig(self, path, clips=clips)
+
     def __repr__(self):
         return (f"Rig({self.name!r}: {len(self.vertices)} vertices, {len(self.faces)} faces, "
                 f"{len(self.skeleton)} joints, {len(self.clips)} clips)")
