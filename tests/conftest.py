@@ -1,4 +1,5 @@
 import os
+import socket
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
@@ -13,3 +14,81 @@ from builders import cylinder_rig
 @pytest.fixture
 def cyl_rig():
     return cylinder_rig()
+
+
+# ---------------------------------------------------------------------- UI test environment
+# The UI tests need pytest-qt and an X display (Xvfb, started by pytest-xvfb). When either is
+# missing they must FAIL, never skip: a skipped UI suite looks green. pytest-xvfb itself only
+# prints a note when Xvfb is not installed and runs on whatever DISPLAY there is (or none, and
+# then Qt aborts the whole process), so check here, before any fixture creates a QApplication.
+UI_FIXTURES = {"qtbot", "qapp", "window"}
+UI_PROBLEM = pytest.StashKey[object]()
+
+
+def _display_reachable(display):
+    """Whether an X server answers on ``display`` (":N", ":N.S" or "host:N")."""
+    host, _, number = display.rpartition(":")
+    try:
+        n = int(number.split(".")[0])
+    except ValueError:
+        return False
+    if host in ("", "unix"):
+        targets = [(socket.AF_UNIX, f"/tmp/.X11-unix/X{n}"),
+                   (socket.AF_UNIX, f"\0/tmp/.X11-unix/X{n}")]  # Linux abstract socket
+    else:
+        targets = [(socket.AF_INET, (host, 6000 + n))]
+    for family, address in targets:
+        with socket.socket(family, socket.SOCK_STREAM) as s:
+            s.settimeout(2.0)
+            try:
+                s.connect(address)
+                return True
+            except OSError:
+                continue
+    return False
+
+
+def ui_environment_problem(config, environ=os.environ):
+    """Why the UI tests cannot run here, or None."""
+    plugins = {getattr(p, "__name__", "") for p in config.pluginmanager.get_plugins()}
+    if "pytestqt.plugin" not in plugins:
+        return ("pytest-qt is not installed (or disabled): the UI tests need it "
+                "(pip install -e '.[test]')")
+    try:
+        import pytest_xvfb
+        xvfb_running = pytest_xvfb.xvfb_instance is not None
+    except ImportError:
+        xvfb_running = False
+    if environ.get("CI") and not xvfb_running:
+        return ("CI is set but pytest-xvfb did not start Xvfb (is the Xvfb binary and "
+                "pytest-xvfb installed?): the UI tests run under Xvfb in CI")
+    platform = environ.get("QT_QPA_PLATFORM", "xcb")
+    if platform.split(":")[0] not in ("xcb", ""):
+        return (f"QT_QPA_PLATFORM={platform}: the UI tests need the xcb platform on an X "
+                "display (pyvistaqt's interactor does not work offscreen)")
+    display = environ.get("DISPLAY")
+    if not display:
+        return ("no X display: DISPLAY is unset and pytest-xvfb did not start Xvfb "
+                "(install the Xvfb binary, e.g. apt-get install xvfb)")
+    if not _display_reachable(display):
+        return f"no X server answers on DISPLAY={display}"
+    return None
+
+
+def is_ui_test(item):
+    return (item.get_closest_marker("ui") is not None
+            or bool(UI_FIXTURES & set(getattr(item, "fixturenames", ()))))
+
+
+def pytest_collection_modifyitems(config, items):
+    if any(is_ui_test(item) for item in items):
+        config.stash[UI_PROBLEM] = ui_environment_problem(config)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_runtest_setup(item):
+    """Fail (not skip) each UI test, before its fixtures run, when the environment cannot
+    run it."""
+    problem = item.config.stash.get(UI_PROBLEM, None)
+    if problem and is_ui_test(item):
+        pytest.fail(f"UI test environment: {problem}", pytrace=False)

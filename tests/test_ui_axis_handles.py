@@ -5,7 +5,6 @@ sphere drag (edit mode: rest position; pose mode: root translation), as one undo
 import numpy as np
 import pytest
 
-pytest.importorskip("pytestqt")
 pytestmark = [pytest.mark.ui, pytest.mark.filterwarnings("error::RuntimeWarning")]
 
 from ui_window_fixture import limb_joint as _limb_joint  # noqa: E402

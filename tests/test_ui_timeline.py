@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-pytest.importorskip("pytestqt")
 pytestmark = [pytest.mark.ui, pytest.mark.filterwarnings("error::RuntimeWarning")]
 
 from PyQt5 import QtCore, QtGui, QtWidgets  # noqa: E402

@@ -4,7 +4,6 @@ edits, undo, view modes, bind mode, bad files, screenshot."""
 import numpy as np
 import pytest
 
-pytest.importorskip("pytestqt")
 pytestmark = [pytest.mark.ui, pytest.mark.filterwarnings("error::RuntimeWarning")]
 
 from ui_window_fixture import limb_joint as _limb_joint  # noqa: E402

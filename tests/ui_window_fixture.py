@@ -1,27 +1,23 @@
-"""The editor window fixture shared by the UI tests (a real window under Xvfb)."""
-import warnings
+"""The editor window fixture shared by the UI tests (a real window under Xvfb).
 
+It opens the bundled quadruped and nothing else: when that rig cannot be loaded the fixture
+fails with the loader's message rather than testing some other rig. (Tests that want the
+small code-built creature for speed build their own window on ``demo_rig()``.)
+"""
 import pytest
 
 import rigedit
 
 _ORIGINAL = {}
-
-
-def _default_rig():
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            return rigedit.load_rig()
-    except (ValueError, OSError):
-        from rigedit.ui.fallback import demo_rig
-
-        return demo_rig()
+RIG = "quadruped"
 
 
 @pytest.fixture(scope="module")
 def rig_template():
-    return _default_rig()
+    try:
+        return rigedit.load_rig(RIG)
+    except (ValueError, OSError) as exc:
+        pytest.fail(f"the UI tests' rig {RIG!r} did not load: {exc}", pytrace=False)
 
 
 @pytest.fixture
@@ -33,8 +29,10 @@ def window(qtbot, rig_template):
     from rigedit.ui import MainWindow
 
     rig = rig_template
-    # Every test starts from the bundled rest state (tests edit the rig in place).
-    rig.skeleton, rig.binding = _ORIGINAL.setdefault(id(rig), (rig.skeleton, rig.binding))
+    # Every test starts from the bundled rest state and place (tests edit the rig in place,
+    # File > Save As moves it).
+    rig.skeleton, rig.binding, rig.path = _ORIGINAL.setdefault(
+        id(rig), (rig.skeleton, rig.binding, rig.path))
     with threadpool_limits(1):
         w = MainWindow(rig)
         qtbot.addWidget(w)
@@ -48,9 +46,10 @@ def window(qtbot, rig_template):
     assert errors == [], "exceptions in VTK callbacks:\n" + "\n".join(errors)
 
 
-def limb_joint(sk):
-    """A joint two below a non-branching chain (a lower leg), for drag tests."""
-    for name in ("fore_cannon_L", "front_foot_L", "hind_cannon_L"):
-        if name in sk.index:
-            return sk.index[name]
-    return len(sk) - 1
+def limb_joint(sk, name="fore_cannon_L"):
+    """Joint ``name`` (by default the quadruped's left fore cannon, two below a non-branching
+    chain: a lower leg), for drag tests; fails the test when the skeleton has no such joint."""
+    if name not in sk.index:
+        pytest.fail(f"expected a joint {name!r} in the test rig, got {', '.join(sk.names)}",
+                    pytrace=False)
+    return sk.index[name]
