@@ -18,7 +18,7 @@ def main(argv=None):
     parser.add_argument("--size", default="1440x900", help="window size WxH (default 1440x900)")
     args = parser.parse_args(argv)
 
-    # One BLAS thread: on a 2-core machine a second one only fights the UI (DESIGN.md).
+    # One BLAS thread: on a 2-core machine a second one only fights the UI (docs/architecture.md).
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     from threadpoolctl import threadpool_limits

@@ -69,7 +69,8 @@ def ensure_venv(extra):
             sys.exit(f"[dev] cannot create a virtual environment ({exc}); "
                      "on Debian: apt-get install python3-venv")
     stamp = VENV / f".installed-{extra or 'base'}"
-    setup_mtime = max((ROOT / f).stat().st_mtime for f in ("setup.cfg", "pyproject.toml"))
+    setup_mtime = max((ROOT / f).stat().st_mtime
+                      for f in ("setup.py", "setup.cfg", "pyproject.toml"))
     if stamp.exists() and stamp.stat().st_mtime >= setup_mtime:
         return
     say("installing rigedit and its dependencies into .venv")

@@ -8,6 +8,7 @@
 """
 from __future__ import annotations
 
+import importlib.resources
 import os
 from pathlib import Path
 
@@ -20,10 +21,27 @@ __all__ = ["load_rig", "save_rig", "resolve_rig_path", "BUNDLED", "ASSETS_DIR", 
            "Skeleton", "Pose", "Clip", "Track", "SkinBinding", "RigFileError"]
 __version__ = "0.1.0"
 
-#: Where the bundled characters live (the repository's assets/ folder, or $RIGEDIT_ASSETS).
-ASSETS_DIR = Path(os.environ.get("RIGEDIT_ASSETS", Path(__file__).resolve().parent.parent / "assets"))
+
+def _assets_dir():
+    """The folder of the bundled characters: ``$RIGEDIT_ASSETS`` when set, else the data package
+    ``rigedit.assets`` through ``importlib.resources`` (the repository's top-level ``assets/``
+    folder: copied into the package by a normal install, mapped onto ``assets/`` by an editable
+    one), else the ``assets/`` folder beside this package in a plain checkout."""
+    if os.environ.get("RIGEDIT_ASSETS"):
+        return Path(os.environ["RIGEDIT_ASSETS"])
+    try:
+        location = Path(str(importlib.resources.files(f"{__name__}.assets")))
+    except ImportError:  # a checkout on sys.path without an install of the package
+        location = None
+    if location is not None and (location / BUNDLED[0]).is_dir():
+        return location
+    return Path(__file__).resolve().parent.parent / "assets"
+
+
 #: Names accepted wherever a rig is asked for; the first is the default.
 BUNDLED = ("quadruped", "humanoid")
+#: Where the bundled characters live (see ``_assets_dir``).
+ASSETS_DIR = _assets_dir()
 
 
 def resolve_rig_path(rig=None):

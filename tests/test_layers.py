@@ -1,4 +1,4 @@
-"""The pure layers never import Qt, VTK or pyvista (DESIGN.md, layers)."""
+"""The pure layers never import Qt, VTK or pyvista (docs/architecture.md, layers)."""
 import subprocess
 import sys
 

@@ -1,7 +1,8 @@
 """The rig's actors in a pyvista plotter: skinned mesh, bones, floor, camera presets.
 
 Used by the interactive view and the off-screen recorder alike; never imports Qt. The mesh
-is added once and its points are updated in place each frame (DESIGN.md, pitfalls).
+is added once and its points are updated in place each frame
+(docs/architecture.md, pitfalls).
 """
 from __future__ import annotations
 
