@@ -45,7 +45,7 @@ def main(argv):
         if (out / "animations").is_dir():  # a clip removed from the build must not linger
             for old in (out / "animations").glob("*.json"):
                 old.unlink()
-        save_rig_folder(out, rig)
+        save_rig_folder(out, rig, allow_bundled=True)
         print(f"{name}: built in {time.time() - t0:.1f} s -> {out}")
 
 

@@ -1,4 +1,9 @@
-"""Crash-safe writes: a temporary file beside the target, then an atomic rename."""
+"""Crash-safe writes: a temporary file beside the target, then an atomic rename.
+
+Errors name the user's file, never the hidden temporary one, and a missing folder is an error
+(:func:`check_output_folder`), not created on the fly: a typo in an output path should not
+leave new folders around.
+"""
 from __future__ import annotations
 
 import contextlib
@@ -7,7 +12,43 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_write", "write_json", "temp_beside"]
+from ..errors import RigFileError
+
+__all__ = ["atomic_write", "write_json", "temp_beside", "check_output_folder",
+           "fsync_folder"]
+
+
+def check_output_folder(path):
+    """``RigFileError`` naming ``path`` unless the folder it goes into exists."""
+    path = Path(path)
+    parent = path.parent
+    if not parent.is_dir():
+        raise RigFileError(path, f"expected an existing folder to write into, got "
+                                 f"{'a file' if parent.exists() else 'no folder'} at {parent}")
+
+
+def fsync_folder(folder):
+    """Make renames and deletions in ``folder`` durable (a power cut after a save keeps
+    them); a no-op where folders cannot be opened (Windows)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _rename_error(exc, tmp, path):
+    """``exc`` as the same OSError naming ``path`` where it named the temporary file."""
+    if isinstance(exc, OSError) and exc.filename in (str(tmp), tmp):
+        new = type(exc)(exc.errno, exc.strerror, str(path))
+        new.__suppress_context__ = True
+        return new
+    return exc
 
 
 def temp_beside(path, suffix=None):
@@ -15,7 +56,12 @@ def temp_beside(path, suffix=None):
     with the permissions a new file would get (``mkstemp`` makes it 0600), or the target's
     own when it exists. Returns ``(fd, tmp_path)``."""
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or ".tmp", dir=path.parent)
+    check_output_folder(path)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or ".tmp",
+                                   dir=path.parent)
+    except OSError as exc:  # say which file could not be written, not the temporary name
+        raise type(exc)(exc.errno, exc.strerror, str(path)) from None
     try:
         mode = path.stat().st_mode & 0o777
     except OSError:
@@ -33,9 +79,9 @@ def atomic_write(path, mode="w", suffix=None):
     A crash or an exception leaves ``path`` as it was and removes the temporary file. Yields
     the open file object (text mode by default, ``mode="wb"`` for bytes). ``suffix`` gives the
     temporary name an extension, for writers that choose the format by it (``np.savez``).
+    The folder must exist (``RigFileError`` naming ``path`` otherwise).
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = temp_beside(path, suffix)
     try:
         with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8"})) as fh:
@@ -43,10 +89,13 @@ def atomic_write(path, mode="w", suffix=None):
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
-        raise
+        new = _rename_error(exc, tmp, path)
+        if new is exc:
+            raise
+        raise new from None
 
 
 def write_json(path, data, indent=1):

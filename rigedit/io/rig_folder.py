@@ -22,12 +22,12 @@ import numpy as np
 
 from ..errors import RigFileError
 from ..rig import Rig
-from .atomic import write_json
-from .clip_json import load_clip, save_clip
+from .clip_json import load_clip
 from .jsonfile import read_json
-from .mesh import MESH_SUFFIXES, load_mesh, save_obj
-from .skeleton_json import load_skeleton, save_skeleton
-from .weights_npz import load_weights, save_weights, weights_vertex_count
+from .mesh import MESH_SUFFIXES, load_mesh
+from .rig_save import recover_interrupted_save, remember_clip_files, save_rig_folder_atomic
+from .skeleton_json import load_skeleton
+from .weights_npz import load_weights, weights_vertex_count
 
 __all__ = ["load_rig_folder", "save_rig_folder", "find_rig_files", "WeightsComputedWarning"]
 
@@ -86,6 +86,8 @@ def load_rig_folder(folder, weights_method="idw"):
     has none, and ``UnknownJointsWarning`` for clips naming joints the skeleton lacks.
     """
     folder = Path(folder)
+    if folder.is_dir():
+        recover_interrupted_save(folder)   # a save killed part-way: finish or undo it
     files = find_rig_files(folder)
     skeleton, meta = load_skeleton(files["skeleton"])
 
@@ -108,26 +110,30 @@ def load_rig_folder(folder, weights_method="idw"):
         vertices, faces = read_mesh(weld=True)
         warnings.warn(f"{folder}: no weights file; computed weights by inverse distance to "
                       f"the bones ({weights_method})", WeightsComputedWarning, stacklevel=2)
-    clips = {}
+    clips, sources = {}, {}
     for path in files["animations"]:
         clip = load_clip(path, skeleton)
-        clips[clip.name] = clip
+        if clip.name in sources:
+            raise RigFileError(path, f"expected one file per clip name, got clip "
+                                     f"{clip.name!r} in both {sources[clip.name]} and {path}")
+        clips[clip.name], sources[clip.name] = clip, path
     up = files["manifest"].get("up", meta["up"])
     name = files["manifest"].get("name", folder.resolve().name)
-    return Rig(skeleton, vertices, faces, indices, weights, clips, name=name, up=up,
-               weights_method=weights_method, path=folder)
+    rig = Rig(skeleton, vertices, faces, indices, weights, clips, name=name, up=up,
+              weights_method=weights_method, path=folder)
+    remember_clip_files(rig, sources)   # a later save replaces exactly these
+    return rig
 
 
-def save_rig_folder(folder, rig, mesh_name="mesh.obj"):
-    """Write ``rig`` as a rig folder in rigedit's formats; each file written atomically."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    save_obj(folder / mesh_name, rig.vertices, rig.faces, header=f"rigedit rig {rig.name}")
-    save_skeleton(folder / "skeleton.json", rig.skeleton, up=rig.up)
-    save_weights(folder / "weights.npz", rig.binding.indices, rig.binding.weights,
-                 rig.skeleton.names)
-    for clip in rig.clips.values():
-        save_clip(folder / "animations" / f"{clip.name}.json", clip)
-    write_json(folder / "rig.json", {"name": rig.name, "mesh": mesh_name,
-                                     "skeleton": "skeleton.json", "weights": "weights.npz",
-                                     "up": rig.up})
+def save_rig_folder(folder, rig, mesh_name="mesh.obj", allow_bundled=False):
+    """Write ``rig`` as a rig folder in rigedit's formats so that the folder matches it: a
+    clip deleted or renamed since it was loaded or last saved loses its file, files rigedit
+    did not write stay, and a crash at any moment leaves the old or the new state (see
+    :mod:`rigedit.io.rig_save`). A bundled character is refused unless ``allow_bundled``.
+
+    Returns
+    -------
+    clip_files : dict[str, str]
+        Clip name -> file written, relative to ``folder``.
+    """
+    return save_rig_folder_atomic(folder, rig, mesh_name=mesh_name, allow_bundled=allow_bundled)

@@ -1,6 +1,6 @@
 """The timeline dock: time ruler, key marks, playback, key editing and the clip selector.
 
-Data flow (DESIGN.md): the ruler only paints and reports mouse gestures; the dock turns them
+Data flow (docs/architecture.md): the ruler paints and reports mouse gestures; the dock turns them
 into document calls. Time goes through ``Document.set_time``; on the document's ``"time"``
 event the dock samples the current clip and shows the pose with ``Document.set_pose`` (no
 undo step), so scrubbing, playback and scripts all take the same path and the 3D view and
@@ -19,6 +19,7 @@ import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
 from ..animation.clip import Clip
+from ..animation.clip_names import check_new_clip_name, name_key
 from ..animation.interpolate import ROTATION_MODES, VECTOR_MODES
 from ..animation.playback import PlaybackClock
 from ..document import Command
@@ -520,14 +521,28 @@ class TimelineDock(QtWidgets.QDockWidget):
         self._push(Command(label, lambda: apply(after), lambda: apply(before)))
 
     def _unique(self, base):
+        """``base``, or ``base 2``, ``base 3``, ...: the first that no clip has (ignoring
+        case, see :mod:`rigedit.animation.clip_names`)."""
+        taken = {name_key(n) for n in self.document.clips}
         name, i = base, 2
-        while name in self.document.clips:
+        while name_key(name) in taken:
             name, i = f"{base} {i}", i + 1
         return name
 
+    def _valid_name(self, name, old=None):
+        """``name`` when the rig can take it, else None with the reason shown (status bar)."""
+        try:
+            return check_new_clip_name(name, self.document.clips, old=old)
+        except ValueError as exc:
+            self._error(str(exc))
+            return None
+
     def new_clip(self, name=None, duration=2.0):
-        """Add an empty clip and make it current. Returns its name."""
-        name = self._unique(name or "clip")
+        """Add an empty clip and make it current. Returns its name, or None (and an error
+        in the status bar) for an invalid name."""
+        name = self._valid_name(self._unique(name or "clip"))
+        if name is None:
+            return None
         clip = Clip(name, self.document.skeleton, {}, duration=duration)
 
         def change():
@@ -546,10 +561,9 @@ class TimelineDock(QtWidgets.QDockWidget):
             if not ok:
                 return None
         new = str(new).strip()
-        if not new or new == old:
+        if new == old:
             return old
-        if new in self.document.clips:
-            self._error(f"a clip called {new!r} already exists")
+        if self._valid_name(new, old=old) is None:
             return None
 
         def change():
@@ -566,7 +580,9 @@ class TimelineDock(QtWidgets.QDockWidget):
         clip = self.clip
         if clip is None:
             return None
-        name = self._unique(f"{clip.name} copy")
+        name = self._valid_name(self._unique(f"{clip.name} copy"))
+        if name is None:
+            return None
         copy = clip.copy(name)
 
         def change():
