@@ -62,6 +62,9 @@ class UndoStack:
         self._done = []
         self._undone = []
         self.observers = []
+        #: Counts every change of the history (push, amend, undo, redo, clear), so a reader
+        #: such as the autosave can tell "changed since I last looked" with one integer.
+        self.revision = 0
 
     def push(self, command, execute=True):
         """Record ``command``; run its ``do`` first unless ``execute`` is false (for edits
@@ -121,6 +124,11 @@ class UndoStack:
         self._notify()
 
     @property
+    def top(self):
+        """The command whose state is current (the last one done), or None."""
+        return self._done[-1] if self._done else None
+
+    @property
     def can_undo(self):
         return bool(self._done)
 
@@ -140,6 +148,7 @@ class UndoStack:
         return len(self._done)
 
     def _notify(self):
+        self.revision += 1
         for cb in list(self.observers):
             cb()
 
@@ -199,6 +208,9 @@ class Document:
     undo_stack : UndoStack
     mode : {"pose", "edit"}
         Pose mode poses the character; edit (bind) mode moves rest positions.
+    modified : bool
+        Whether the data differs from what was last saved or opened (undoing back to the
+        saved state makes it false again).
     """
 
     def __init__(self, rig):
@@ -208,6 +220,7 @@ class Document:
         self.mode = "pose"
         self._drag_before = None
         self._set_rig(rig)
+        self._saved_top = None  # the undo stack's top command when last saved or opened
 
     # ------------------------------------------------------------------ observers
     def subscribe(self, callback):
@@ -232,11 +245,28 @@ class Document:
         self.time = 0.0
         self.mirror = mirror_map(rig.skeleton.names)
 
-    def set_rig(self, rig):
-        """Replace the rig (a file was opened): new pose, selection cleared, history cleared."""
+    def set_rig(self, rig, modified=False):
+        """Replace the rig (a file was opened): new pose, selection cleared, history cleared.
+        ``modified`` marks it unsaved (a recovered document)."""
         self._set_rig(rig)
         self.undo_stack.clear()
+        self._saved_top = _NEVER_SAVED if modified else None
         self.emit("rig")
+
+    # ------------------------------------------------------------------ saved state
+    @property
+    def modified(self):
+        return self.undo_stack.top is not self._saved_top
+
+    def mark_saved(self):
+        """The current state is what is on disk (after a successful save)."""
+        self._saved_top = self.undo_stack.top
+        self.emit("undo")
+
+    def mark_modified(self):
+        """The current state is not on disk, whatever the history says (recovered work)."""
+        self._saved_top = _NEVER_SAVED
+        self.emit("undo")
 
     @property
     def skeleton(self):
@@ -394,6 +424,10 @@ class Document:
 
     def redo(self):
         return self.undo_stack.redo()
+
+
+#: A saved-state marker that no command matches: the document is unsaved.
+_NEVER_SAVED = object()
 
 
 def mirror_pose(pose, mirror, names, axis, source="L"):

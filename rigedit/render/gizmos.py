@@ -1,8 +1,10 @@
 """Joint gizmos: one VTK sphere widget per joint, and X/Y/Z axis handles at the selected joint.
 
 Never imports Qt. The owner passes three callbacks, ``on_start(j)``, ``on_move(j, center)`` and
-``on_end(j)``; exceptions in them are caught (VTK would print and swallow them), kept in
-``errors`` and re-emitted as warnings so that tests run with warnings as errors fail.
+``on_end(j)``; exceptions in them are caught (VTK would print and swallow them) and kept in
+``errors``; then they go to the owner's ``on_error(what)`` handler (the editor shows and logs
+them), or, without one, are re-emitted as warnings so that tests run with warnings as errors
+fail.
 """
 from __future__ import annotations
 
@@ -22,11 +24,16 @@ ACTIVE_COLOR = (1.0, 0.95, 0.35)  # while being dragged
 AXIS_COLORS = ((0.90, 0.25, 0.25), (0.30, 0.80, 0.30), (0.30, 0.50, 0.95))
 
 
-def _record_failure(errors, what):
-    """Keep the traceback of a failed VTK callback in ``errors`` and warn with it."""
+def _record_failure(owner, what):
+    """Keep the traceback of a failed VTK callback in ``owner.errors``, then hand the
+    exception (still being handled) to ``owner.on_error(what)``, or warn with it."""
     tb = traceback.format_exc()
-    errors.append(tb)
-    warnings.warn(f"{what} callback failed:\n{tb}", RuntimeWarning, stacklevel=2)
+    owner.errors.append(tb)
+    handler = owner.on_error
+    if handler is None:
+        warnings.warn(f"{what} callback failed:\n{tb}", RuntimeWarning, stacklevel=2)
+    else:
+        handler(f"The {what} callback")
 
 
 def world_to_display(renderer, world):
@@ -113,6 +120,9 @@ class JointGizmos:
         The joint being dragged.
     errors : list of str
         Tracebacks of exceptions raised by the callbacks.
+    on_error : callable or None
+        ``on_error(what)`` is called inside the ``except`` block of a failed callback
+        (``sys.exc_info()`` is the exception); None warns instead.
     """
 
     def __init__(self, plotter, positions, radius, on_start=None, on_move=None, on_end=None,
@@ -123,6 +133,7 @@ class JointGizmos:
         self.selected = None
         self.active = None
         self.errors = []
+        self.on_error = None
         self.visible = True
         renderer = renderer or plotter.renderer
         iren = plotter.iren.interactor
@@ -158,7 +169,7 @@ class JointGizmos:
             try:
                 fn(j, widget)
             except Exception:  # noqa: BLE001 - VTK would swallow it; keep it visible
-                _record_failure(self.errors, "joint gizmo")
+                _record_failure(self, "joint gizmo")
         return callback
 
     def _start(self, j, widget):
@@ -258,6 +269,7 @@ class AxisHandles:
         self.on_start, self.on_move, self.on_end = on_start, on_move, on_end
         self.gizmos = gizmos
         self.errors = gizmos.errors if gizmos is not None else []
+        self._on_error = None
         self.actors = []
         self.axis = None
         self.grabbed = None
@@ -410,8 +422,19 @@ class AxisHandles:
                 if fn(obj):
                     obj.GetCommand(self._tag(event)).SetAbortFlag(1)
             except Exception:  # noqa: BLE001 - VTK would swallow it; keep it visible
-                _record_failure(self.errors, "axis handle")
+                _record_failure(self, "axis handle")
         return callback
+
+    @property
+    def on_error(self):
+        """This one's own handler, else the joint gizmos' it was built with."""
+        if self._on_error is not None or self.gizmos is None:
+            return self._on_error
+        return self.gizmos.on_error
+
+    @on_error.setter
+    def on_error(self, handler):
+        self._on_error = handler
 
     def _tag(self, event):
         names = ("LeftButtonPressEvent", "MouseMoveEvent", "LeftButtonReleaseEvent")

@@ -24,8 +24,6 @@ class DragMixin:
         """A drag of joint ``j`` begins: constrained to ``axis`` (an arrow handle's) or to
         the toolbar's axis."""
         d = self.document
-        if self.job is not None:
-            self.status("Busy: wait for the current job or cancel it")
         d.select(j)
         self._interacting = True
         self._drag = {"joint": j, "start": self.gizmos.center(j),
@@ -100,28 +98,72 @@ class DragMixin:
 
     # ================================================================== bind mode
     def rebind_moved_joint(self, j, head):
-        """Move joint ``j``'s rest position to ``head`` and re-bind the skin in a worker."""
+        """Move joint ``j``'s rest position to ``head`` and re-bind the skin in a worker.
+
+        Returns the :class:`Job`, or None when another job runs (a second rest move is
+        refused with a status message, and the view snaps back).
+
+        While it runs the user may keep posing: the finished re-bind keeps the pose the
+        document has then (offset by the rest change), not the one it started from. Undo
+        pressed before any newer edit cancels it (the rest move was the last thing done).
+        A result whose rig, skeleton or weights were replaced meanwhile (another rig opened,
+        a rest edit redone, weights loaded) is dropped with a status message rather than
+        applied to data it was not computed for.
+        """
         d = self.document
-        before = d.rest_state()
-        skeleton = skeleton_with_moved_joint(d.skeleton, j, head)
-        vertices = d.rig.vertices
         name = d.skeleton.names[j]
+        if self.job is not None:
+            self._refresh_pose()  # the dragged bone and sphere go back to the rest position
+            self.gizmos.set_center(j, self.scene.joint_positions[j])
+            self.request_render()
+            self.status(f"Busy with '{self.job.label}': {name} keeps its rest position; wait "
+                        f"for it to finish or cancel it, then move the joint again")
+            return None
+        rig, base_skeleton, base_binding = d.rig, d.skeleton, d.rig.binding
+        skeleton = skeleton_with_moved_joint(base_skeleton, j, head)
+        vertices = rig.vertices
+        label = f"Move {name} (rest)"
 
         def done(result):
+            self._pending_rebind = None
+            if d.rig is not rig or d.skeleton is not base_skeleton \
+                    or d.rig.binding is not base_binding:
+                what = "another rig was opened" if d.rig is not rig else \
+                    "the skeleton or the weights changed"
+                self._refresh_pose()
+                self.status(f"Re-bind after moving {name} dropped: {what} while it ran; "
+                            f"move the joint again")
+                return
             indices, weights = result
+            before = d.rest_state()  # the pose now, with any edit made while it ran
             pose = before[2].copy()
-            delta = skeleton.rest_translation - before[0].rest_translation
-            pose[:, :3] += delta  # keep the pose's offsets from rest
-            d.push_rest_edit(f"Move {name} (rest)", before,
-                             d.make_rest_state(skeleton, indices, weights, pose))
+            pose[:, :3] += skeleton.rest_translation - base_skeleton.rest_translation
+            d.push_rest_edit(label, before, d.make_rest_state(skeleton, indices, weights, pose))
             self.status(f"Moved {name}'s rest position and re-bound the skin "
                         f"({len(vertices):,} vertices)")
 
         def cancelled():
+            self._pending_rebind = None
             self._refresh_pose()
             self.request_render()
             self.status(f"Re-bind cancelled; {name} keeps its rest position")
 
-        self.run_job(f"Re-binding after moving {name}",
-                     lambda report: weights_in_chunks(vertices, skeleton, report=report),
-                     done, cancelled)
+        job = self.run_job(f"Re-binding after moving {name}",
+                           lambda report: weights_in_chunks(vertices, skeleton, report=report),
+                           done, cancelled)
+        # Where the move sits in the history: undo from here cancels it.
+        self._pending_rebind = (job, d.undo_stack.top, label) if job is not None else None
+        self._update_undo_actions()
+        return job
+
+    def undo(self):
+        """Edit > Undo: cancels a running re-bind when it is the latest edit, else undoes the
+        document's last step."""
+        pending = getattr(self, "_pending_rebind", None)
+        if pending is not None and pending[0] is self.job and \
+                self.document.undo_stack.top is pending[1]:
+            self._pending_rebind = None
+            self.job.cancel()
+            self.status(f"Undo {pending[2]}: re-bind cancelled")
+            return None
+        return self.document.undo()

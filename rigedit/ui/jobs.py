@@ -7,7 +7,6 @@ thread through Qt signals, where the caller applies them (VTK calls stay on the 
 from __future__ import annotations
 
 import threading
-import traceback
 
 from PyQt5 import QtCore
 
@@ -64,8 +63,11 @@ class Job(QtCore.QThread):
         except (ValueError, KeyError, OSError) as exc:
             self.failed.emit(str(exc).strip("'\""))
         except Exception as exc:  # noqa: BLE001 - shown to the user, never a silent thread death
-            traceback.print_exc()
-            self.failed.emit(f"{type(exc).__name__}: {exc}")
+            from .errors_hook import describe, logger
+
+            summary = describe(type(exc), exc, exc.__traceback__)
+            logger().error("%s failed: %s", self.label, summary, exc_info=True)
+            self.failed.emit(f"unexpected {summary}; details in the log")
         else:
             self.succeeded.emit(result)
 

@@ -5,6 +5,7 @@ Data flow: user input -> :class:`~rigedit.document.Document` methods -> document
 """
 from __future__ import annotations
 
+import sys
 import warnings
 from pathlib import Path
 
@@ -12,9 +13,12 @@ import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 from pyvistaqt import QtInteractor
 
+from .. import recovery
 from ..document import Document
 from ..render.gizmos import AxisHandles, JointGizmos, gizmo_radius, overlay_renderer
 from ..render.scene import RigScene
+from . import errors_hook
+from .autosave import Autosave
 from .drag import DragMixin
 from .menus import MenusMixin
 from .file_actions import FileActions
@@ -81,6 +85,10 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         self.chain_length = 2
         self.last_error = None
         self.job = None
+        self._pending_rebind = None  # (job, undo-stack top at its start, label)
+        self.keep_recovery = False   # set when quitting on a signal: the entry must stay
+        self._error_dialog = None
+        self._error_count = 0
         self.gizmos = None
         self.axes = None
         self._drag = None
@@ -94,6 +102,8 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         self._build_status_bar()
         self.document.subscribe(self._on_document)
         self._load_scene()
+        self.autosave = Autosave(self)
+        errors_hook.install(self)
         self.resize(1440, 900)
         self.status(note or f"Loaded {rig.name}: drag a joint sphere to pose; "
                             f"Ctrl+Z undoes")
@@ -108,7 +118,8 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
     def _route_renders_through_qt(self):
         """Make VTK's own render requests (a sphere widget after each mouse move, the camera
         style) schedule one Qt paint instead of rendering now: the widget's paint renders
-        again anyway, and two renders per mouse move halved the drag rate (DESIGN pitfalls).
+        again anyway, and two renders per mouse move halved the drag rate
+        (docs/architecture.md, pitfalls).
 
         ``vtkRenderWindowInteractor.Render`` always fires ``RenderEvent``, even with
         rendering disabled, so that such a redirect is possible.
@@ -208,6 +219,7 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         self.gizmos = JointGizmos(self.plotter, self.scene.joint_positions, self.radius,
                                   self._drag_start, self._drag_move, self._drag_end,
                                   renderer=self.overlay)
+        self.gizmos.on_error = self.report_exception
         self.gizmos.set_visible(self.gizmos_action.isChecked())
         # The selected joint's X/Y/Z arrows are handles: a drag on one runs the same code
         # as a sphere drag, constrained to that axis.
@@ -218,7 +230,7 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         self.joint_panel.set_skeleton(rig.skeleton)
         self.info_panel.show_rig(rig)
         self.info_panel.show_selection(rig, None)
-        self.setWindowTitle(f"rigedit — {rig.name}")
+        self._update_title()
         self._refresh_pose()
         self._update_undo_actions()
         self._update_mode_label()
@@ -280,13 +292,24 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
             self.request_render()
         elif event == "undo":
             self._update_undo_actions()
+            self._update_title()
 
     def _update_undo_actions(self):
         s = self.document.undo_stack
-        self.undo_action.setEnabled(s.can_undo)
+        pending = self._pending_rebind
+        if pending is not None and pending[0] is self.job and s.top is pending[1]:
+            self.undo_action.setEnabled(True)  # undo cancels the running re-bind
+            self.undo_action.setText(f"&Undo {pending[2]}")
+        else:
+            self.undo_action.setEnabled(s.can_undo)
+            self.undo_action.setText(f"&Undo {s.undo_label}".strip())
         self.redo_action.setEnabled(s.can_redo)
-        self.undo_action.setText(f"&Undo {s.undo_label}".strip())
         self.redo_action.setText(f"&Redo {s.redo_label}".strip())
+
+    def _update_title(self):
+        """"rigedit — name", with a star while there are unsaved changes."""
+        d = self.document
+        self.setWindowTitle(f"rigedit — {d.rig.name}{' *' if d.modified else ''}")
 
     # ================================================================== view options
     def display_mode(self):
@@ -383,7 +406,8 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         """Run ``fn(report)`` off the UI thread with a progress bar and a Cancel button;
         ``on_done(result)`` runs on the main thread. Returns the :class:`Job`."""
         if self.job is not None:
-            self.error("Busy", f"wait for '{self.job.label}' to finish, or cancel it")
+            self.error("Busy", f"busy with '{self.job.label}': wait for it to finish, or "
+                               f"cancel it, then try '{label}' again")
             return None
         job = Job(label, fn, self)
         self.job = job
@@ -404,6 +428,7 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
             self.job = None
             self.progress.setVisible(False)
             self.cancel_button.setVisible(False)
+            self._update_undo_actions()
 
         def ok(result):
             finish()
@@ -411,12 +436,14 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
                 on_done(result)
             except ValueError as exc:
                 self.error(label, str(exc))
+            except Exception:  # noqa: BLE001 - a bug: shown and logged, the editor goes on
+                self.report_exception(label)
 
         def failed(msg):
             finish()
-            self.error(label, msg)
             if on_cancel:
                 on_cancel()
+            self.error(label, msg)  # after on_cancel, so its status does not hide the error
 
         def cancelled():
             finish()
@@ -431,6 +458,7 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         job.finished.connect(job.deleteLater)
         self.status(f"{label}...")
         job.start()
+        self._update_undo_actions()
         return job
 
     def cancel_job(self):
@@ -439,7 +467,41 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
 
     # ================================================================== messages
     def status(self, text, timeout=0):
+        self.statusBar().setStyleSheet("")
         self.statusBar().showMessage(text, timeout)
+
+    def report_exception(self, what=None):
+        """Log and show the exception being handled (see :mod:`.errors_hook`); for code that
+        must not let it propagate (VTK observers, job callbacks)."""
+        errors_hook.report(what, sys.exc_info())
+
+    def show_unexpected_error(self, what, summary):
+        """Show an unexpected error (a bug, not bad input): a red status message naming what
+        failed and one non-modal dialog (reused while open, with a count); the document is
+        written for recovery first, as the state after a bug may not be trustworthy."""
+        saved = self.autosave.crash_save() if hasattr(self, "autosave") else False
+        self._error_count += 1
+        what = what or "An operation"
+        log = recovery.log_path()
+        self.last_error = f"{what} failed: {summary}"
+        self.statusBar().showMessage(f"Error: {what} failed: {summary} — details in {log}")
+        self.statusBar().setStyleSheet("QStatusBar { color: #ff6b6b; font-weight: bold }")
+        text = (f"{what} failed unexpectedly:\n{summary}\n\n"
+                + ("Your work was written to a recovery file. " if saved else "")
+                + f"The details are in {log}.")
+        if self._error_count > 1:
+            text += f"\n\n({self._error_count} errors so far)"
+        box = self._error_dialog
+        if box is None or not box.isVisible():
+            box = QtWidgets.QMessageBox(QtWidgets.QMessageBox.Critical, "rigedit: error", "",
+                                        QtWidgets.QMessageBox.Ok, self)
+            box.setAttribute(QtCore.Qt.WA_DeleteOnClose)
+            box.destroyed.connect(lambda *_: setattr(self, "_error_dialog", None))
+            self._error_dialog = box
+            box.setText(text)
+            box.open()
+        else:
+            box.setText(text)
 
     def error(self, title, message):
         """Show one clear message: a dialog (not blocking) and the status bar."""
@@ -491,6 +553,10 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         if self.job is not None:
             self.job.cancel()
             self.job.wait(5000)
+        self.autosave.stop()
+        if not self.keep_recovery:
+            self.autosave.discard()  # a clean close leaves no recovery entry
+        errors_hook.uninstall(self)
         if self.axes is not None:
             self.axes.remove()
         if self.gizmos is not None:

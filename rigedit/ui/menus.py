@@ -49,7 +49,7 @@ class MenusMixin:
         m.addAction(self._action("&Quit", self.close, "Ctrl+Q"))
 
         m = bar.addMenu("&Edit")
-        self.undo_action = self._action("&Undo", self.document.undo, QtGui.QKeySequence.Undo)
+        self.undo_action = self._action("&Undo", self.undo, QtGui.QKeySequence.Undo)
         self.redo_action = self._action("&Redo", self.document.redo, QtGui.QKeySequence.Redo)
         m.addAction(self.undo_action)
         m.addAction(self.redo_action)

@@ -1,0 +1,218 @@
+"""Autosave and recovery in the editor, as Blender does: the document is written to a
+recovery entry in the user's cache folder every few minutes when it changed, and at once on
+an unexpected error or a termination signal; the next start offers to recover what an
+editor that is no longer running left behind. Where and how entries are written is
+:mod:`rigedit.recovery` (pure); this module holds the timer, the signals and the dialog.
+
+The interval is ``RIGEDIT_AUTOSAVE_SECONDS`` (default 120; 0 turns the timer off, the
+crash and signal saves stay).
+"""
+from __future__ import annotations
+
+import os
+import signal
+import socket
+
+from PyQt5 import QtCore, QtWidgets
+
+from .. import recovery
+from ..errors import RigFileError
+from . import errors_hook
+
+__all__ = ["Autosave", "DEFAULT_INTERVAL", "offer_recovery", "ask_recover", "recover",
+           "install_signal_handlers"]
+
+DEFAULT_INTERVAL = 120.0  # seconds (Blender's default is 2 minutes too)
+
+
+def _interval_from_env():
+    text = os.environ.get("RIGEDIT_AUTOSAVE_SECONDS", "")
+    try:
+        value = float(text) if text else DEFAULT_INTERVAL
+    except ValueError:
+        value = DEFAULT_INTERVAL
+    return value if value >= 0 and value == value else DEFAULT_INTERVAL
+
+
+class Autosave(QtCore.QObject):
+    """Writes the window's document to this process's recovery entry.
+
+    Parameters
+    ----------
+    window : MainWindow
+    interval : float, optional
+        Seconds between checks (``RIGEDIT_AUTOSAVE_SECONDS`` or 120 by default; 0: no
+        timer).
+
+    Attributes
+    ----------
+    folder : Path
+        This editor's recovery entry folder.
+    writes : int
+        Snapshots written so far.
+    """
+
+    def __init__(self, window, interval=None):
+        super().__init__(window)
+        self.window = window
+        self.folder = recovery.entry_folder()
+        self.writes = 0
+        self._written = None  # undo-stack revision of the last snapshot
+        self.timer = QtCore.QTimer(self)
+        self.timer.timeout.connect(self.tick)
+        self.set_interval(_interval_from_env() if interval is None else interval)
+
+    def set_interval(self, seconds):
+        self.interval = float(seconds)
+        self.timer.stop()
+        if self.interval > 0:
+            self.timer.start(int(round(self.interval * 1000)))
+
+    @property
+    def document(self):
+        return self.window.document
+
+    def tick(self):
+        """The timer's check: write when the document changed; wait while a drag is under
+        way (its intermediate pose is not an edit yet)."""
+        if self.document.dragging or getattr(self.window, "_interacting", False):
+            return False
+        return self.save()
+
+    def save(self, force=False):
+        """Write a snapshot if the document has unsaved changes made since the last one
+        (``force``: even when none were made since). A document without unsaved changes
+        needs no recovery: its entry is removed. Returns whether a snapshot was written."""
+        doc = self.document
+        if not doc.modified:
+            self.discard()
+            return False
+        if not force and doc.undo_stack.revision == self._written:
+            return False
+        try:
+            recovery.write_entry(doc.rig, doc.pose_snapshot(), doc.current_clip, doc.time,
+                                 original_path=doc.rig.path, folder=self.folder)
+        except (OSError, ValueError) as exc:
+            errors_hook.logger().error("autosave to %s failed: %s", self.folder, exc)
+            self.window.status(f"Autosave failed: {exc}")
+            return False
+        self._written = doc.undo_stack.revision
+        self.writes += 1
+        return True
+
+    def crash_save(self):
+        """Save for recovery after an unexpected error or on a signal; never raises."""
+        try:
+            return self.save(force=True)
+        except Exception:  # noqa: BLE001 - called while handling a failure already
+            errors_hook.logger().error("recovery save failed", exc_info=True)
+            return False
+
+    def discard(self):
+        """Remove this editor's recovery entry (a clean close, or nothing left unsaved)."""
+        if self.folder.exists():
+            recovery.remove_entry(self.folder)
+        self._written = None
+
+    def stop(self):
+        self.timer.stop()
+
+
+# ---------------------------------------------------------------------- recovery at start
+def ask_recover(window, entry):
+    """Ask what to do with a recovery entry: "recover", "discard" or "later"."""
+    box = QtWidgets.QMessageBox(window)
+    box.setIcon(QtWidgets.QMessageBox.Question)
+    box.setWindowTitle("Recover unsaved work")
+    box.setText("An editor that is no longer running left unsaved work:")
+    box.setInformativeText(f"{entry.describe()}\n\nRecover it now, discard it, or decide "
+                           "the next time rigedit starts?")
+    recover_button = box.addButton("Recover", QtWidgets.QMessageBox.AcceptRole)
+    discard_button = box.addButton("Discard", QtWidgets.QMessageBox.DestructiveRole)
+    box.addButton("Later", QtWidgets.QMessageBox.RejectRole)
+    box.setDefaultButton(recover_button)
+    box.exec_()
+    clicked = box.clickedButton()
+    return "recover" if clicked is recover_button else \
+        "discard" if clicked is discard_button else "later"
+
+
+def offer_recovery(window, ask=None):
+    """Offer each entry left by an editor that no longer runs, newest first. The first one
+    recovered replaces the window's document (the rest stay for a later start).
+
+    Parameters
+    ----------
+    ask : callable, optional
+        ``ask(window, entry) -> "recover" | "discard" | "later"`` (:func:`ask_recover`).
+
+    Returns
+    -------
+    RecoveryEntry or None
+        The entry recovered.
+    """
+    ask = ask or ask_recover
+    for entry in recovery.stale_entries():
+        choice = ask(window, entry)
+        if choice == "discard":
+            recovery.remove_entry(entry.folder)
+        elif choice == "recover" and recover(window, entry):
+            return entry
+    return None
+
+
+def recover(window, entry):
+    """Open a recovery entry in ``window`` as an unsaved document (its Save goes to the
+    original folder; Save As when there was none or it was a bundled character). The entry
+    is removed once this editor's own recovery snapshot holds the work. Returns success."""
+    try:
+        rig, pose, clip, time = recovery.read_entry(entry)
+    except (RigFileError, ValueError, OSError) as exc:
+        window.error("Recover", f"cannot recover {entry.describe()}: {exc}")
+        return False
+    doc = window.document
+    doc.set_rig(rig, modified=True)
+    doc.set_current_clip(clip)
+    doc.set_time(time)
+    doc.set_pose(pose)
+    if window.autosave.save(force=True):
+        recovery.remove_entry(entry.folder)
+    window.status(f"Recovered {entry.describe()}; save it to keep it")
+    return True
+
+
+# ---------------------------------------------------------------------- signals
+def install_signal_handlers(app, window, signals=(signal.SIGTERM, signal.SIGINT, signal.SIGHUP)):
+    """On a termination signal, write the recovery snapshot and quit with status
+    128 + signal (the entry stays: the next start offers it).
+
+    Python runs signal handlers only between bytecodes, and a Qt event loop may wait in C
+    for a long time: ``signal.set_wakeup_fd`` writes to a socket that a QSocketNotifier
+    watches, so the handler runs at once. Returns the notifier (keep it alive).
+    """
+    rsock, wsock = socket.socketpair()
+    for s in (rsock, wsock):
+        s.setblocking(False)
+    signal.set_wakeup_fd(wsock.fileno())
+    notifier = QtCore.QSocketNotifier(rsock.fileno(), QtCore.QSocketNotifier.Read, app)
+
+    def drain():
+        try:
+            rsock.recv(64)
+        except OSError:
+            pass
+
+    notifier.activated.connect(drain)
+    notifier._sockets = (rsock, wsock)
+
+    def on_signal(signum, _frame):
+        name = signal.Signals(signum).name
+        errors_hook.logger().warning("%s received: writing the recovery snapshot", name)
+        window.autosave.crash_save()
+        window.autosave.stop()
+        window.keep_recovery = True
+        app.exit(128 + signum)
+
+    for s in signals:
+        signal.signal(s, on_signal)
+    return notifier
