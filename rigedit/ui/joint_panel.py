@@ -14,6 +14,19 @@ __all__ = ["JointPanel", "InfoPanel"]
 AXES = "XYZ"
 
 
+def nearest_euler(angles, near):
+    """Of the two XYZ Euler triples of one rotation, ``(a, b, c)`` and
+    ``(a + 180, 180 - b, c + 180)`` (degrees, wrapped to [-180, 180)), the one nearest to
+    ``near``, (3,) each."""
+    angles = np.asarray(angles, dtype=float)
+    other = (angles * [1, -1, 1] + 180.0 + 180.0) % 360.0 - 180.0
+
+    def distance(a):
+        return np.abs((a - near + 180.0) % 360.0 - 180.0).sum()
+
+    return other if distance(other) < distance(angles) else angles
+
+
 class JointPanel(QtWidgets.QWidget):
     """Tree + rotation (X/Y/Z degrees relative to rest, slider and spin box), translation,
     scale, and reset / mirror buttons.
@@ -152,7 +165,10 @@ class JointPanel(QtWidgets.QWidget):
         self.show_joint(None, None)
 
     def show_joint(self, joint, pose):
-        """Show ``joint``'s values from ``pose`` (signals blocked)."""
+        """Show ``joint``'s values from ``pose`` (signals blocked). For the joint already
+        shown, the angles stay the Euler triple nearest to those on display (a slider held
+        past 90 degrees on Y must not jump to the other triple of the same rotation)."""
+        same_joint = joint is not None and joint == self.joint
         self.joint = joint
         widgets = (self.sliders + self.angle_boxes + self.translation_boxes + self.scale_boxes
                    + [self.tree])
@@ -172,6 +188,8 @@ class JointPanel(QtWidgets.QWidget):
                 self.tree.scrollToItem(item)
             self.title.setText(f"Joint: {pose.skeleton.names[joint]}")
             angles = pose.get_euler(joint, degrees=True)
+            if same_joint:
+                angles = nearest_euler(angles, self.angles())
             for k in range(3):
                 self.angle_boxes[k].setValue(float(angles[k]))
                 self.sliders[k].setValue(int(round(angles[k] * 10)))
