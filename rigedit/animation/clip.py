@@ -64,9 +64,11 @@ class Track:
             if np.any(norm < 1e-12):
                 raise ValueError("rotation track: expected unit quaternions, got a zero one")
             values = values / norm
-            for i in range(1, len(values)):
-                if np.dot(values[i - 1], values[i]) < 0:
-                    values[i] = -values[i]
+            # each key to its predecessor's hemisphere: key i flips when an odd number of the
+            # raw neighbour products up to i are negative (the same as a loop, without one)
+            dots = np.sum(values[1:] * values[:-1], axis=1)
+            flips = np.cumprod(np.where(dots < 0, -1.0, 1.0))
+            values[1:] *= flips[:, None]
         mode = interpolation or DEFAULT_MODE[channel]
         if channel == "rotation" and mode == "linear":
             mode = "nlerp"
