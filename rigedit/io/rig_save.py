@@ -259,8 +259,9 @@ def _apply(folder, journal):
             os.unlink(folder / rel)
     fsync_folder(folder / ANIMATIONS)
     fsync_folder(folder)
-    os.unlink(stage / JOURNAL)   # from here on the staging folder is only litter
-    fsync_folder(stage)
+    # From here on the staging folder is only litter (and applying the journal again after a
+    # power cut that forgot this deletion is harmless), so no fsync.
+    os.unlink(stage / JOURNAL)
     _remove_tree(stage)
 
 
