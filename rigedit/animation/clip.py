@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.pose import Pose
+from .clip_names import check_clip_name
 from .interpolate import ROTATION_MODES, VECTOR_MODES, catmull_rom_tangents, sample_track
 
 __all__ = ["CHANNELS", "Track", "Clip"]
@@ -142,6 +143,7 @@ class Clip:
     Parameters
     ----------
     name : str
+        Checked by :func:`~rigedit.animation.clip_names.check_clip_name` (``ValueError``).
     skeleton : Skeleton
         Joints without a track keep their rest value.
     tracks : dict[(str, str), Track]
@@ -152,7 +154,7 @@ class Clip:
     """
 
     def __init__(self, name, skeleton, tracks=None, duration=None, loop=True):
-        self.name = str(name)
+        self.name = check_clip_name(name)
         self.skeleton = skeleton
         self.tracks = {}
         self.loop = bool(loop)
