@@ -122,6 +122,7 @@ class FileActions:
                              f"Saved {rig.name} to {path}"):
             return False
         rig.path = Path(path)
+        self.doc.mark_saved()  # no unsaved changes: the title loses its star, autosave rests
         return True
 
     def export_pose(self, path=None):
