@@ -27,10 +27,13 @@ class Rig:
     up : {"y", "z"}
         The vertical axis (bundled characters and glTF: y; the elk format: z).
     weights_method : str
+    surface : rigedit.surface.Surface, optional
+        Normals, texture coordinates and materials where the source file had them (glTF);
+        None otherwise. Rig folders do not store it yet.
     """
 
     def __init__(self, skeleton, vertices, faces, indices=None, weights=None, clips=None,
-                 name="rig", up="y", weights_method="idw", path=None):
+                 name="rig", up="y", weights_method="idw", path=None, surface=None):
         self.skeleton = skeleton
         self.vertices = np.asarray(vertices, dtype=np.float64)
         self.faces = np.asarray(faces, dtype=np.int64)
@@ -38,6 +41,7 @@ class Rig:
         self.name = name
         self.up = up
         self.path = path
+        self.surface = surface
         self.weights_computed = indices is None
         if indices is None:
             indices, weights = compute_weights(self.vertices, skeleton, weights_method)

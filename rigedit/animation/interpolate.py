@@ -11,6 +11,9 @@ mode               channels                    what it does
                                                between the two keys, SLERP above
 ``catmull_rom``    all three                   centripetal Catmull-Rom (alpha = 0.5)
                                                through the keys, C1 in time
+``cubic_spline``   all three                   cubic Hermite with an in- and an out-tangent
+                                               stored per key (glTF's CUBICSPLINE); rotations
+                                               are normalised after, not hemisphere-aligned
 =================  ==========================  ===========================================
 
 Every function takes the key arrays of one track and a sample time and returns the value; the
@@ -49,8 +52,8 @@ __all__ = ["MODES", "VECTOR_MODES", "ROTATION_MODES", "HYBRID_THRESHOLD", "segme
            "sample_track", "lerp", "nlerp", "slerp", "hybrid", "catmull_rom_tangents",
            "hermite"]
 
-VECTOR_MODES = ("step", "linear", "catmull_rom")
-ROTATION_MODES = ("step", "nlerp", "slerp", "hybrid", "catmull_rom")
+VECTOR_MODES = ("step", "linear", "catmull_rom", "cubic_spline")
+ROTATION_MODES = ("step", "nlerp", "slerp", "hybrid", "catmull_rom", "cubic_spline")
 MODES = tuple(dict.fromkeys(VECTOR_MODES + ROTATION_MODES))
 
 #: Rotation angle between two keys (radians) above which ``hybrid`` uses SLERP. Below 30
@@ -98,7 +101,8 @@ def slerp(a, b, u):
     d = float(np.dot(a, b))
     if d < 0:
         b, d = -b, -d
-    if d > 0.9995:  # nearly parallel: the sine ratio is ill-conditioned, NLERP is exact enough
+    if d > 1.0 - 1e-10:  # nearly parallel (under ~1e-5 rad): the sine ratio is ill-conditioned,
+        # NLERP equals SLERP there to ~1e-15 (a looser switch, 0.9995, erred by ~1e-5)
         q = a + (b - a) * u
         return q / np.linalg.norm(q)
     theta = np.arccos(d)
@@ -184,8 +188,10 @@ def sample_track(times, values, t, mode, rotation, tangents=None):
     mode : str, one of ``MODES``
     rotation : bool
         Quaternion track (C = 4) or vector track.
-    tangents : (K, C) float64, optional
-        Baked :func:`catmull_rom_tangents` for ``catmull_rom`` (computed when omitted).
+    tangents : (K, C) or (K, 2, C) float64, optional
+        Baked :func:`catmull_rom_tangents` for ``catmull_rom`` (computed when omitted); for
+        ``cubic_spline`` (required) the in-tangent ``[:, 0]`` and out-tangent ``[:, 1]`` of
+        each key, in units per second.
 
     Returns
     -------
@@ -193,7 +199,14 @@ def sample_track(times, values, t, mode, rotation, tangents=None):
     """
     i, k, u = segment(times, t)
     if i == k or mode == "step":
+        if rotation and mode == "cubic_spline":  # keys kept as given, maybe not unit
+            return values[i] / np.linalg.norm(values[i])
         return values[i].copy()
+    if mode == "cubic_spline":
+        # glTF's CUBICSPLINE: the out-tangent of key i and the in-tangent of key k, scaled by
+        # the segment length (the tangents are per second).
+        q = hermite(values[i], values[k], tangents[i, 1], tangents[k, 0], times[k] - times[i], u)
+        return q / np.linalg.norm(q) if rotation else q
     if mode == "catmull_rom":
         if tangents is None:
             lo, hi = max(i - 1, 0), min(k + 2, len(times))

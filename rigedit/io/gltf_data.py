@@ -1,0 +1,284 @@
+"""glTF 2.0 containers and accessors: the GLB/JSON file, its buffers, and typed arrays.
+
+pygltflib parses the JSON into objects; this module checks the GLB container itself (pygltflib
+accepts a wrong version or chunk lengths that disagree with the file) and decodes accessors
+into numpy arrays in one vectorised step each: byte strides, sparse substitution, normalised
+integers, matrix column padding, embedded GLB buffers, external ``.bin`` files and data URIs.
+Every problem is one :class:`~rigedit.errors.RigFileError` naming the file.
+"""
+from __future__ import annotations
+
+import base64
+import json
+import struct
+import urllib.parse
+from pathlib import Path
+
+import numpy as np
+import pygltflib
+
+from ..errors import RigFileError
+
+__all__ = ["GltfData", "COMPONENT_DTYPES", "TYPE_WIDTHS", "SUPPORTED_EXTENSIONS"]
+
+GLB_MAGIC = b"glTF"
+CHUNK_JSON = 0x4E4F534A
+CHUNK_BIN = 0x004E4942
+
+COMPONENT_DTYPES = {5120: np.dtype("<i1"), 5121: np.dtype("<u1"), 5122: np.dtype("<i2"),
+                    5123: np.dtype("<u2"), 5125: np.dtype("<u4"), 5126: np.dtype("<f4")}
+TYPE_WIDTHS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
+#: Largest value of each normalised integer type (signed ones clamp at -1, per the spec).
+_NORM = {5120: 127.0, 5121: 255.0, 5122: 32767.0, 5123: 65535.0}
+#: Extensions that change how geometry must be read and that rigedit implements.
+SUPPORTED_EXTENSIONS = ("KHR_mesh_quantization",)
+
+
+def _int(value, what, path, low=0):
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+        raise RigFileError(path, f"expected {what} to be an integer >= {low}, got {value!r}")
+    return int(value)
+
+
+class GltfData:
+    """A parsed glTF file with decoded buffers.
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``.glb`` or ``.gltf`` file (the container is recognised by its magic, not its name).
+
+    Attributes
+    ----------
+    gltf : pygltflib.GLTF2
+    path : Path
+    """
+
+    def __init__(self, path):
+        self.path = Path(path)
+        try:
+            raw = self.path.read_bytes()
+        except OSError as exc:
+            raise RigFileError(self.path, f"cannot read the file ({exc.strerror or exc})") from None
+        self._bin = None
+        if raw[:4] == GLB_MAGIC:
+            text = self._split_glb(raw)
+        elif raw.lstrip()[:1] == b"{":
+            text = raw
+        else:
+            raise RigFileError(self.path, f"expected a glTF file (JSON) or a GLB (magic 'glTF'), "
+                                          f"got bytes {raw[:4]!r}")
+        try:
+            text = text.decode("utf-8")
+            doc = json.loads(text)
+        except (UnicodeDecodeError, ValueError) as exc:
+            raise RigFileError(self.path, f"expected glTF JSON, got invalid JSON ({exc})") from None
+        if not isinstance(doc, dict) or not isinstance(doc.get("asset"), dict):
+            raise RigFileError(self.path, "expected a glTF JSON object with an 'asset', got none")
+        version = str(doc["asset"].get("version", ""))
+        if not version.startswith("2."):
+            raise RigFileError(self.path, f"expected glTF version 2.x, got {version!r}")
+        try:
+            # from_json (not from_dict) turns primitive attributes into pygltflib's objects
+            self.gltf = pygltflib.GLTF2.from_json(text, infer_missing=True)
+        except Exception as exc:  # pygltflib raises whatever its dataclass decoder meets
+            raise RigFileError(self.path, f"expected valid glTF objects, got {exc}") from None
+        required = list(self.gltf.extensionsRequired or [])
+        missing = [e for e in required if e not in SUPPORTED_EXTENSIONS]
+        if missing:
+            raise RigFileError(self.path, f"the file requires the extension {missing[0]}, which "
+                                          f"rigedit does not support (supported: "
+                                          f"{', '.join(SUPPORTED_EXTENSIONS)})")
+        self._buffers = {}
+
+    # ------------------------------------------------------------------ container
+    def _split_glb(self, raw):
+        """Check a GLB header and chunks; keep the BIN chunk, return the JSON bytes."""
+        if len(raw) < 20:
+            raise RigFileError(self.path, f"expected a GLB header and a JSON chunk, got "
+                                          f"{len(raw)} bytes")
+        version, length = struct.unpack_from("<II", raw, 4)
+        if version != 2:
+            raise RigFileError(self.path, f"expected GLB container version 2, got {version}")
+        if length != len(raw):
+            raise RigFileError(self.path, f"expected the GLB length in the header ({length} "
+                                          f"bytes) to equal the file size, got {len(raw)} bytes")
+        chunks, offset = [], 12
+        while offset < length:
+            if offset + 8 > length:
+                raise RigFileError(self.path, f"expected a chunk header at byte {offset}, got "
+                                              "the end of the file")
+            size, kind = struct.unpack_from("<II", raw, offset)
+            if offset + 8 + size > length:
+                raise RigFileError(self.path, f"expected chunk {len(chunks)} ({size} bytes at "
+                                              f"byte {offset + 8}) to fit in the file of "
+                                              f"{length} bytes, got it past the end")
+            chunks.append((kind, raw[offset + 8:offset + 8 + size]))
+            offset += 8 + size
+        if not chunks or chunks[0][0] != CHUNK_JSON:
+            raise RigFileError(self.path, "expected the first GLB chunk to be JSON, got "
+                                          + (f"type 0x{chunks[0][0]:08x}" if chunks else "none"))
+        if len(chunks) > 1 and chunks[1][0] == CHUNK_BIN:
+            self._bin = chunks[1][1]
+        return chunks[0][1]
+
+    def item(self, kind, index, what):
+        """``(index, object)`` of ``gltf.<kind>[index]``; a RigFileError when out of range."""
+        items = getattr(self.gltf, kind) or []
+        index = _int(index, f"{what} index", self.path)
+        if index >= len(items):
+            raise RigFileError(self.path, f"expected {what} index below {len(items)}, got "
+                                          f"{index}")
+        return index, items[index]
+
+    def buffer(self, index):
+        """The bytes of buffer ``index`` (GLB chunk, data URI or external file), cached."""
+        if index in self._buffers:
+            return self._buffers[index]
+        index, buf = self.item("buffers", index, "buffer")
+        where = f"buffer {index}"
+        if buf.uri is None:
+            if index != 0 or self._bin is None:
+                raise RigFileError(self.path, f"{where}: expected a uri or the GLB binary chunk, "
+                                              "got neither")
+            data = self._bin
+        else:
+            data = self.uri_bytes(buf.uri, where)
+        declared = _int(buf.byteLength, f"{where} byteLength", self.path, 1)
+        if declared > len(data):
+            raise RigFileError(self.path, f"{where}: expected {declared} bytes (byteLength), "
+                                          f"got {len(data)}")
+        self._buffers[index] = data
+        return data
+
+    def uri_bytes(self, uri, where):
+        """Bytes behind a data URI or a file path relative to the glTF file."""
+        if not isinstance(uri, str):
+            raise RigFileError(self.path, f"{where}: expected a uri string, got {uri!r}")
+        if uri.startswith("data:"):
+            head, sep, payload = uri.partition(",")
+            if not sep:
+                raise RigFileError(self.path, f"{where}: expected a data URI with a comma, got "
+                                              f"{uri[:40]!r}")
+            try:
+                if head.endswith(";base64"):
+                    return base64.b64decode(payload, validate=True)
+                return urllib.parse.unquote_to_bytes(payload)
+            except ValueError as exc:
+                raise RigFileError(self.path, f"{where}: bad base64 data ({exc})") from None
+        target = self.path.parent / urllib.parse.unquote(uri)
+        try:
+            return target.read_bytes()
+        except OSError as exc:
+            raise RigFileError(self.path, f"{where}: cannot read {target} "
+                                          f"({exc.strerror or exc})") from None
+
+    def view_bytes(self, index, where):
+        """(bytes, stride or None) of buffer view ``index``, bounds checked."""
+        index, view = self.item("bufferViews", index, f"{where}: bufferView")
+        data = self.buffer(view.buffer)
+        start = _int(view.byteOffset or 0, f"bufferView {index} byteOffset", self.path)
+        length = _int(view.byteLength, f"bufferView {index} byteLength", self.path, 1)
+        if start + length > len(data):
+            raise RigFileError(self.path, f"bufferView {index}: expected bytes {start}.."
+                                          f"{start + length} inside buffer {view.buffer} of "
+                                          f"{len(data)} bytes, got past its end")
+        stride = view.byteStride
+        if stride is not None:
+            stride = _int(stride, f"bufferView {index} byteStride", self.path, 4)
+        return memoryview(data)[start:start + length], stride
+
+    # ------------------------------------------------------------------ accessors
+    def _strided(self, view, offset, count, dtype, width, stride, where, matrix=False):
+        """(count, width) array of ``dtype`` read from ``view`` at ``offset`` every ``stride``
+        bytes (``stride`` None: tightly packed). Matrix columns of 1- and 2-byte components
+        are padded to 4 bytes, as the spec lays them out."""
+        size = dtype.itemsize
+        rows, cols = {4: (2, 2), 9: (3, 3), 16: (4, 4)}[width] if matrix else (width, 1)
+        col_bytes = size * rows
+        col_stride = -(-col_bytes // 4) * 4 if cols > 1 and size < 4 else col_bytes
+        elem = col_stride * cols
+        stride = stride or elem
+        if stride < elem:
+            raise RigFileError(self.path, f"{where}: expected a byteStride of at least {elem}, "
+                                          f"got {stride}")
+        end = offset + stride * (count - 1) + elem if count else offset
+        if end > len(view):
+            raise RigFileError(self.path, f"{where}: expected {count} elements from byte "
+                                          f"{offset} to fit in its bufferView of {len(view)} "
+                                          f"bytes, got past its end (byte {end})")
+        if count == 0:
+            return np.zeros((0, width), dtype=dtype)
+        block = np.frombuffer(view, dtype=np.uint8, count=end - offset, offset=offset)
+        block = np.concatenate([block, np.zeros(stride * count - len(block), np.uint8)])
+        block = block.reshape(count, stride)
+        parts = [block[:, c * col_stride:c * col_stride + col_bytes] for c in range(cols)]
+        packed = np.ascontiguousarray(np.concatenate(parts, axis=1))
+        return packed.view(dtype).reshape(count, width)
+
+    def accessor(self, index, where="accessor"):
+        """Decode accessor ``index``.
+
+        Returns
+        -------
+        values : (count, width) ndarray
+            float64 for float and normalised accessors, the integer type otherwise. Matrices
+            are flattened column-major, as stored (reshape to (n, 4, 4) and transpose).
+        """
+        index, acc = self.item("accessors", index, f"{where}: accessor")
+        where = f"accessor {index} ({where})"
+        dtype = COMPONENT_DTYPES.get(acc.componentType)
+        width = TYPE_WIDTHS.get(acc.type)
+        if dtype is None or width is None:
+            raise RigFileError(self.path, f"{where}: expected a known componentType and type, "
+                                          f"got {acc.componentType!r} {acc.type!r}")
+        count = _int(acc.count, f"{where} count", self.path, 1)
+        if acc.bufferView is None:
+            out = np.zeros((count, width), dtype=dtype)
+        else:
+            view, stride = self.view_bytes(acc.bufferView, where)
+            offset = _int(acc.byteOffset or 0, f"{where} byteOffset", self.path)
+            out = self._strided(view, offset, count, dtype, width, stride, where,
+                                matrix=acc.type.startswith("MAT")).copy()
+        if acc.sparse is not None:
+            self._apply_sparse(acc, out, dtype, width, where)
+        if dtype.kind == "f":
+            return out.astype(np.float64)
+        if acc.normalized:
+            if acc.componentType not in _NORM:
+                raise RigFileError(self.path, f"{where}: expected a normalised byte or short, "
+                                              f"got componentType {acc.componentType}")
+            return np.maximum(out / _NORM[acc.componentType], -1.0)
+        return out
+
+    def _apply_sparse(self, acc, out, dtype, width, where):
+        sparse = acc.sparse
+        n = _int(sparse.count, f"{where} sparse count", self.path, 1)
+        ind = sparse.indices
+        idx_dtype = COMPONENT_DTYPES.get(ind.componentType)
+        if ind.componentType not in (5121, 5123, 5125):
+            raise RigFileError(self.path, f"{where}: expected sparse indices of unsigned type, "
+                                          f"got componentType {ind.componentType!r}")
+        view, _ = self.view_bytes(ind.bufferView, f"{where} sparse indices")
+        idx = self._strided(view, _int(ind.byteOffset or 0, "sparse byteOffset", self.path), n,
+                            idx_dtype, 1, None, f"{where} sparse indices")[:, 0].astype(np.int64)
+        if idx.max() >= len(out) or np.any(np.diff(idx) <= 0):
+            raise RigFileError(self.path, f"{where}: expected strictly increasing sparse indices "
+                                          f"below {len(out)}, got {idx.min()}..{idx.max()}")
+        val = sparse.values
+        view, _ = self.view_bytes(val.bufferView, f"{where} sparse values")
+        out[idx] = self._strided(view, _int(val.byteOffset or 0, "sparse byteOffset", self.path),
+                                 n, dtype, width, None, f"{where} sparse values",
+                                 matrix=acc.type.startswith("MAT"))
+
+    def image_bytes(self, index):
+        """(bytes, mime type or None) of image ``index``."""
+        index, image = self.item("images", index, "image")
+        where = f"image {index}"
+        if image.bufferView is not None:
+            view, _ = self.view_bytes(image.bufferView, where)
+            return bytes(view), image.mimeType
+        mime = image.mimeType
+        if mime is None and isinstance(image.uri, str) and image.uri.startswith("data:"):
+            mime = image.uri[5:].split(";")[0].split(",")[0] or None
+        return self.uri_bytes(image.uri, where), mime

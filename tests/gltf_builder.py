@@ -1,0 +1,228 @@
+"""Small glTF files built in code for the reader's tests (JSON dicts + one binary buffer)."""
+from __future__ import annotations
+
+import base64
+import json
+import struct
+from pathlib import Path
+
+import numpy as np
+
+CTYPES = {np.dtype("int8"): 5120, np.dtype("uint8"): 5121, np.dtype("int16"): 5122,
+          np.dtype("uint16"): 5123, np.dtype("uint32"): 5125, np.dtype("float32"): 5126}
+TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4", 16: "MAT4"}
+
+
+class GltfBuilder:
+    """Accumulates buffer views and accessors into one buffer."""
+
+    def __init__(self):
+        self.doc = {"asset": {"version": "2.0"}, "buffers": [], "bufferViews": [],
+                    "accessors": [], "nodes": [], "meshes": [], "skins": [], "scenes": [{}],
+                    "scene": 0}
+        self.bin = bytearray()
+
+    def view(self, data, stride=None):
+        while len(self.bin) % 4:
+            self.bin.append(0)
+        view = {"buffer": 0, "byteOffset": len(self.bin), "byteLength": len(data)}
+        if stride:
+            view["byteStride"] = stride
+        self.bin += data
+        self.doc["bufferViews"].append(view)
+        return len(self.doc["bufferViews"]) - 1
+
+    def accessor(self, array, dtype="float32", normalized=False, view=None, offset=0,
+                 minmax=False):
+        """Add ``array`` (N, C) as an accessor (in its own view unless ``view`` is given)."""
+        arr = np.asarray(array)
+        arr = arr.reshape(len(arr), -1).astype(dtype)
+        if view is None:
+            view = self.view(arr.tobytes())
+        acc = {"bufferView": view, "byteOffset": offset, "componentType": CTYPES[arr.dtype],
+               "count": len(arr), "type": TYPES[arr.shape[1]]}
+        if normalized:
+            acc["normalized"] = True
+        if minmax:
+            acc["min"] = arr.min(axis=0).tolist()
+            acc["max"] = arr.max(axis=0).tolist()
+        self.doc["accessors"].append(acc)
+        return len(self.doc["accessors"]) - 1
+
+    def interleaved(self, arrays, dtypes):
+        """Accessors for several (N, C) arrays interleaved in one strided view."""
+        parts = [np.asarray(a).reshape(len(a), -1).astype(d) for a, d in zip(arrays, dtypes)]
+        sizes = [p.itemsize * p.shape[1] for p in parts]
+        pads = [(-s) % 4 for s in sizes]
+        stride = sum(sizes) + sum(pads)
+        rows = bytearray()
+        for i in range(len(parts[0])):
+            for p, pad in zip(parts, pads):
+                rows += p[i].tobytes() + bytes(pad)
+        view = self.view(bytes(rows), stride=stride)
+        out, offset = [], 0
+        for p, s, pad in zip(parts, sizes, pads):
+            out.append(self.accessor(p, p.dtype, view=view, offset=offset))
+            offset += s + pad
+        return out
+
+    def sparse(self, base, indices, values):
+        """Make accessor ``base`` sparse: ``values`` replace its rows ``indices``."""
+        vals = np.asarray(values).astype(np.dtype(
+            {v: k for k, v in CTYPES.items()}[self.doc["accessors"][base]["componentType"]]))
+        self.doc["accessors"][base]["sparse"] = {
+            "count": len(indices),
+            "indices": {"bufferView": self.view(np.asarray(indices, np.uint16).tobytes()),
+                        "componentType": 5123},
+            "values": {"bufferView": self.view(vals.tobytes())}}
+
+    def write(self, path, container="glb"):
+        """Write as ``glb``, ``embedded`` (data URI) or ``external`` (.gltf + .bin)."""
+        path = Path(path)
+        while len(self.bin) % 4:
+            self.bin.append(0)
+        doc = json.loads(json.dumps(self.doc))
+        doc["buffers"] = [{"byteLength": len(self.bin)}]
+        if container == "embedded":
+            doc["buffers"][0]["uri"] = ("data:application/octet-stream;base64,"
+                                        + base64.b64encode(bytes(self.bin)).decode())
+        elif container == "external":
+            (path.parent / (path.stem + " data.bin")).write_bytes(bytes(self.bin))
+            doc["buffers"][0]["uri"] = path.stem + "%20data.bin"
+        if container == "glb":
+            text = json.dumps(doc).encode()
+            text += b" " * ((-len(text)) % 4)
+            body = (struct.pack("<II", len(text), 0x4E4F534A) + text
+                    + struct.pack("<II", len(self.bin), 0x004E4942) + bytes(self.bin))
+            path.write_bytes(b"glTF" + struct.pack("<II", 2, 12 + len(body)) + body)
+        else:
+            path.write_text(json.dumps(doc))
+        return path
+
+
+def trs_matrix(t=(0, 0, 0), q=(0, 0, 0, 1), s=(1, 1, 1)):
+    from scipy.spatial.transform import Rotation
+
+    m = np.eye(4)
+    m[:3, :3] = Rotation.from_quat(q).as_matrix() * np.asarray(s)[None, :]
+    m[:3, 3] = t
+    return m
+
+
+def two_bone(ancestor=None, names=("root", "tip"), mode=4, **options):
+    """A bar of 8 vertices along +y bound to two joints, with one clip bending the tip.
+
+    Parameters
+    ----------
+    ancestor : dict, optional
+        A non-joint parent node of the root joint (e.g. {"rotation": [...], "scale": [...]}).
+    names : (str or None, str or None)
+        Joint node names (None: unnamed).
+    mode : 4, 5 or 6
+        Triangle list, strip or fan.
+    options : positions ("float", "quantized"), normals ("float", "byte"), layout
+        ("separate", "interleaved"), sparse (bool), weights ("float", "ubyte", "ushort"),
+        interpolation ("LINEAR", "STEP", "CUBICSPLINE").
+
+    Returns
+    -------
+    builder : GltfBuilder
+    expected : dict with "positions" (8, 3), "faces" (F, 3) the triangles expected back.
+    """
+    b = GltfBuilder()
+    y = np.repeat(np.arange(4) * 0.5, 2)
+    pos = np.stack([np.tile([-0.1, 0.1], 4), y, np.zeros(8)], axis=1)
+    if options.get("sparse"):
+        pos_stored = pos.copy()
+        pos_stored[[2, 5]] = 9.0           # wrong in the dense part, fixed by the sparse part
+    else:
+        pos_stored = pos
+    nrm = np.tile([0.0, 0.0, 1.0], (8, 1))
+    wt = np.stack([1 - y / 1.5, y / 1.5, np.zeros(8), np.zeros(8)], axis=1)
+    jt = np.tile([0, 1, 0, 0], (8, 1))
+    attrs = {}
+    quant = options.get("positions") == "quantized"
+    pos_arr, pos_dtype = (np.round(pos_stored * 1000), "int16") if quant else (pos_stored, "float32")
+    nrm_arr, nrm_dtype = (np.round(nrm * 127), "int8") if options.get("normals") == "byte" \
+        else (nrm, "float32")
+    if options.get("layout") == "interleaved":
+        attrs["POSITION"], attrs["NORMAL"] = b.interleaved([pos_arr, nrm_arr],
+                                                           [pos_dtype, nrm_dtype])
+    else:
+        attrs["POSITION"] = b.accessor(pos_arr, pos_dtype)
+        attrs["NORMAL"] = b.accessor(nrm_arr, nrm_dtype)
+    if options.get("normals") == "byte":
+        b.doc["accessors"][attrs["NORMAL"]]["normalized"] = True
+    if options.get("sparse"):
+        b.sparse(attrs["POSITION"], [2, 5], pos_arr[[2, 5]] * 0 + (
+            np.round(pos[[2, 5]] * 1000) if quant else pos[[2, 5]]))
+    b.doc["accessors"][attrs["POSITION"]].update(
+        min=(pos_arr.min(0)).tolist(), max=(pos_arr.max(0)).tolist())
+    attrs["JOINTS_0"] = b.accessor(jt, "uint8")
+    kind = options.get("weights", "float")
+    if kind == "float":
+        attrs["WEIGHTS_0"] = b.accessor(wt, "float32")
+    else:
+        top = 255 if kind == "ubyte" else 65535
+        attrs["WEIGHTS_0"] = b.accessor(np.round(wt * top), "uint8" if kind == "ubyte"
+                                        else "uint16", normalized=True)
+    strip = np.arange(8)
+    tris = np.array([[0, 1, 3], [0, 3, 2], [2, 3, 5], [2, 5, 4], [4, 5, 7], [4, 7, 6]])
+    if mode == 4:
+        idx, faces = tris.ravel(), tris
+    elif mode == 5:
+        idx = strip
+        i = np.arange(6)
+        faces = np.stack([strip[i], strip[i + 1 + i % 2], strip[i + 2 - i % 2]], axis=1)
+    else:
+        idx = np.array([0, 1, 3, 5, 7, 6, 4, 2])
+        faces = np.stack([idx[1:-1], idx[2:], np.zeros(6, int)], axis=1)
+    prim = {"attributes": attrs, "indices": b.accessor(idx, "uint16"), "mode": mode}
+    b.doc["meshes"].append({"primitives": [prim]})
+    scale_q = 1e-3 if quant else 1.0
+    # node 0 (optional ancestor), then the mesh node, then the joints
+    nodes = b.doc["nodes"]
+    first = 0
+    if ancestor is not None:
+        nodes.append(dict(ancestor, name="Armature", children=[]))
+        first = 1
+    mesh_node = {"mesh": 0, "skin": 0, "name": "body"}
+    if quant:
+        # KHR_mesh_quantization: the integer positions are scaled by a node transform; for a
+        # skinned mesh the inverse bind matrices carry that scale (the node's is ignored)
+        b.doc["extensionsUsed"] = b.doc["extensionsRequired"] = ["KHR_mesh_quantization"]
+    nodes.append(mesh_node)
+    root = {"translation": [0.0, 0.0, 0.0], "children": [len(nodes) + 1]}
+    tip = {"translation": [0.0, 1.0, 0.0]}
+    for node, name in zip((root, tip), names):
+        if name is not None:
+            node["name"] = name
+    nodes += [root, tip]
+    j0, j1 = len(nodes) - 2, len(nodes) - 1
+    if ancestor is not None:
+        nodes[0]["children"] = [j0]
+        anc = trs_matrix(ancestor.get("translation", (0, 0, 0)),
+                         ancestor.get("rotation", (0, 0, 0, 1)), ancestor.get("scale", (1, 1, 1)))
+    else:
+        anc = np.eye(4)
+    bind = [anc @ trs_matrix((0, 0, 0)), anc @ trs_matrix((0, 1, 0))]
+    ibm = np.stack([np.linalg.inv(m) @ np.diag([scale_q] * 3 + [1]) for m in bind])
+    skin = {"joints": [j0, j1],
+            "inverseBindMatrices": b.accessor(ibm.transpose(0, 2, 1).reshape(2, 16), "float32")}
+    b.doc["skins"].append(skin)
+    b.doc["scenes"][0]["nodes"] = [0, first] if ancestor is not None else [first, j0]
+    times = np.array([0.0, 0.5, 1.0])
+    half = np.sin(np.radians([0, 30, 60]) / 2)
+    quats = np.stack([half, np.zeros(3), np.zeros(3), np.cos(np.radians([0, 30, 60]) / 2)], 1)
+    interp = options.get("interpolation", "LINEAR")
+    if interp == "CUBICSPLINE":
+        tang = np.zeros((3, 4))
+        tang[:, 0] = 0.4
+        out = np.stack([tang, quats, -tang], axis=1).reshape(-1, 4)
+    else:
+        out = quats
+    b.doc["animations"] = [{"name": options.get("clip_name", "bend"), "samplers": [
+        {"input": b.accessor(times, "float32", minmax=True), "output": b.accessor(out, "float32"),
+         "interpolation": interp}],
+        "channels": [{"sampler": 0, "target": {"node": j1, "path": "rotation"}}]}]
+    return b, {"positions": pos, "faces": faces, "weights": wt[:, :2]}
