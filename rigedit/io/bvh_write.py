@@ -1,0 +1,198 @@
+"""BVH out: a rig's skeleton and one clip, sampled at the clip's key rate.
+
+BVH has no rest rotations, no scale and no bind pose: a joint's local transform is
+``T(offset or position channels) · R(rotation channels)``. So the writer does not copy the
+rig's local values; it takes the model-space joint matrices of every frame (whatever made
+them: rest rotations, translation or scale keys, glTF bind poses) and writes the local
+rotation and translation that reproduce each joint's model-space position and orientation:
+
+    R_j = rotation of M_j (nearest rotation when scale is present)
+    rotation channels of j = R_parent^T R_j            (``Zrotation Xrotation Yrotation``)
+    local translation of j = R_parent^T (p_j - p_parent)
+
+OFFSETs come from the rest pose the same way; a joint gets position channels when it is a
+root or when its local translation moves away from its offset during the clip. Reading the
+file back gives the same joint positions per frame. Lengths are written in centimetres by
+default (the most common BVH unit, which rigedit's unit guess reads back as such for a
+human-sized figure).
+"""
+from __future__ import annotations
+
+import re
+import warnings
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..errors import RigFileError
+from .atomic import atomic_write
+
+__all__ = ["save_bvh", "bvh_frame_times", "DEFAULT_FPS"]
+
+#: Frame rate used when a clip's keys are not on a regular grid.
+DEFAULT_FPS = 30.0
+_AXES = "XYZ"
+
+
+def bvh_frame_times(clip, fps=None):
+    """Sample times for writing ``clip``: its key rate when every key lies on one regular grid
+    of step ``dt`` from time 0, else ``fps`` (default 30) frames per second.
+
+    Returns
+    -------
+    times : (F,) float64
+        ``k * dt`` for k = 0 .. round(duration / dt).
+    dt : float
+    """
+    if clip is None:
+        return np.zeros(1), 1.0 / (fps or DEFAULT_FPS)
+    if fps is None:
+        keys = np.unique(np.concatenate([tr.times for tr in clip.tracks.values()] or [[0.0]]))
+        dt = 1.0 / DEFAULT_FPS
+        if len(keys) >= 2:
+            step = float(np.min(np.diff(keys)))
+            grid = keys / step
+            if step > 1e-6 and np.allclose(grid, np.round(grid), atol=1e-4):
+                dt = step
+    else:
+        dt = 1.0 / float(fps)
+    count = int(round(clip.duration / dt)) + 1 if clip.duration > 0 else 1
+    return np.arange(count) * dt, dt
+
+
+def _model_frames(rig, clip, times):
+    """(F, J, 4, 4) model matrices of the clip at ``times`` (the rest pose when no clip)."""
+    if clip is None:
+        return rig.joint_matrices(rig.rest_pose())[None]
+    return np.stack([rig.joint_matrices(clip.sample(t)) for t in times])
+
+
+def _local_parts(model, parents):
+    """Local rotations (..., J) Rotation-ready matrices and translations that reproduce
+    the positions of ``model`` (..., J, 4, 4) joint by joint."""
+    lin = model[..., :3, :3]
+    # nearest rotation of each (possibly scaled) matrix
+    u, _, vt = np.linalg.svd(lin)
+    d = np.sign(np.linalg.det(u @ vt))
+    u[..., :, 2] *= d[..., None]
+    rot = u @ vt
+    pos = model[..., :3, 3]
+    local_rot = rot.copy()
+    local_t = pos.copy()
+    child = np.flatnonzero(parents >= 0)
+    par = parents[child]
+    rp_t = np.swapaxes(rot[..., par, :, :], -1, -2)
+    local_rot[..., child, :, :] = rp_t @ rot[..., child, :, :]
+    local_t[..., child, :] = (rp_t @ (pos[..., child, :] - pos[..., par, :])[..., None])[..., 0]
+    return local_rot, local_t, rot, pos
+
+
+def _depth_first(parents):
+    children = {j: [] for j in range(-1, len(parents))}
+    for j, p in enumerate(parents):
+        children[int(p)].append(j)
+    order, stack = [], list(reversed(children[-1]))
+    while stack:
+        j = stack.pop()
+        order.append(j)
+        stack.extend(reversed(children[j]))
+    return order, children
+
+
+def _bvh_names(names):
+    out, seen = [], set()
+    for name in names:
+        base = re.sub(r"[\s{}]+", "_", name) or "joint"
+        new, k = base, 1
+        while new in seen:
+            k += 1
+            new = f"{base}_{k}"
+        seen.add(new)
+        out.append(new)
+    return out
+
+
+def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order="ZXY"):
+    """Write ``rig``'s skeleton and one clip as a BVH file, atomically.
+
+    Parameters
+    ----------
+    rig : Rig
+    path : str or os.PathLike
+    clip : Clip or str, optional
+        The clip to write; the rig's first clip when omitted, the rest pose (one frame)
+        when the rig has none.
+    fps : float, optional
+        Frame rate; the clip's key rate when its keys lie on a regular grid, else 30.
+    units_per_metre : float
+        File units per metre (100: centimetres).
+    order : str
+        Rotation channel order, three of ``XYZ`` (``ZXY`` writes ``Zrotation Xrotation
+        Yrotation``).
+
+    Returns
+    -------
+    info : dict
+        ``clip`` (name or None), ``frames``, ``frame_time``.
+    """
+    if isinstance(clip, str):
+        if clip not in rig.clips:
+            raise RigFileError(path, f"expected a clip of the rig, got {clip!r}")
+        clip = rig.clips[clip]
+    if clip is None and rig.clips:
+        clip = next(iter(rig.clips.values()))
+    order = order.upper()
+    if sorted(order) != ["X", "Y", "Z"]:
+        raise ValueError(f"expected a rotation order of X, Y and Z, got {order!r}")
+    sk = rig.skeleton
+    times, dt = bvh_frame_times(clip, fps)
+    local_rot, local_t, _, _ = _local_parts(_model_frames(rig, clip, times), sk.parents)
+    rest_model = rig.joint_matrices(rig.rest_pose())
+    _, offsets, rest_rot, rest_pos = _local_parts(rest_model, sk.parents)
+    size = float(np.ptp(np.vstack([rest_pos, local_t[:, 0]]), axis=0).max()) or 1.0
+    moves = np.abs(local_t - offsets[None]).max(axis=(0, 2)) > 1e-9 * size
+    with_pos = (sk.parents < 0) | moves
+    order_dfs, children = _depth_first(sk.parents)
+    names = _bvh_names(sk.names)
+    s = float(units_per_metre)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # gimbal lock: angles still reproduce R
+        euler = Rotation.from_matrix(local_rot.reshape(-1, 3, 3)).as_euler(
+            order, degrees=True).reshape(len(times), len(sk), 3)
+    rot_channels = " ".join(f"{a}rotation" for a in order)
+    lines = ["HIERARCHY"]
+    columns = []
+
+    def write(j, depth):
+        pad = "  " * depth
+        kind = "ROOT" if sk.parents[j] < 0 else "JOINT"
+        o = offsets[j] * s
+        chans = ("Xposition Yposition Zposition " if with_pos[j] else "") + rot_channels
+        lines.extend([f"{pad}{kind} {names[j]}", f"{pad}{{",
+                      f"{pad}  OFFSET {o[0]:.6f} {o[1]:.6f} {o[2]:.6f}",
+                      f"{pad}  CHANNELS {6 if with_pos[j] else 3} {chans}"])
+        if with_pos[j]:
+            columns.append(local_t[:, j] * s)
+        columns.append(euler[:, j])
+        for c in children[j]:
+            write(c, depth + 1)
+        if not children[j]:
+            end = np.zeros(3)
+            if np.all(np.isfinite(sk.tails[j])):
+                tail = rest_model[j] @ sk.inverse_bind_matrices[j] @ np.r_[sk.tails[j], 1.0]
+                end = rest_rot[j].T @ (tail[:3] - rest_pos[j]) * s
+            lines.extend([f"{pad}  End Site", f"{pad}  {{",
+                          f"{pad}    OFFSET {end[0]:.6f} {end[1]:.6f} {end[2]:.6f}",
+                          f"{pad}  }}"])
+        lines.append(f"{pad}}}")
+
+    for j in order_dfs:
+        if sk.parents[j] < 0:
+            write(j, 0)
+    lines += ["MOTION", f"Frames: {len(times)}", f"Frame Time: {dt:.10g}"]
+    data = np.concatenate(columns, axis=1)
+    with atomic_write(path) as fh:
+        fh.write("\n".join(lines) + "\n")
+        np.savetxt(fh, data, fmt="%.6f")
+    return {"clip": None if clip is None else clip.name, "frames": len(times),
+            "frame_time": dt}
