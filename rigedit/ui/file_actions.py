@@ -10,6 +10,7 @@ from PyQt5 import QtWidgets
 
 from ..io.atomic import write_json
 from ..io.rig_folder import load_rig_folder, save_rig_folder
+from ..io.rig_save import is_bundled
 from ..io.skeleton_json import save_skeleton
 from ..io.weights_npz import load_weights, save_weights
 from .jobs import weights_in_chunks
@@ -95,14 +96,31 @@ class FileActions:
 
     # ------------------------------------------------------------------ save
     def save(self):
+        """Save into the folder the rig came from; a rig without one, or a bundled character
+        (read-only), asks for a new place (Save As)."""
         path = self.doc.rig.path
-        if path is None or not Path(path).is_dir():
+        if path is None or not Path(path).is_dir() or is_bundled(path):
             return self.save_as()
         return self.save_to(path)
 
     def save_as(self, path=None):
+        """Save into a folder chosen by the user (or ``path``). A folder that holds another
+        rig is replaced only after the user confirms."""
         path = path or QtWidgets.QFileDialog.getExistingDirectory(self.w, "Save rig into folder")
-        return self.save_to(path) if path else None
+        if not path:
+            return None
+        current = self.doc.rig.path
+        other_rig = (Path(path) / "rig.json").is_file() and not (
+            current is not None and Path(current).resolve() == Path(path).resolve())
+        if other_rig and not is_bundled(path) and not self._confirm_replace(path):
+            return None
+        return self.save_to(path)
+
+    def _confirm_replace(self, path):
+        answer = QtWidgets.QMessageBox.question(
+            self.w, "Save rig", f"{path} already holds a rig. Replace it with this one? "
+            "(Its clips that this rig lacks are deleted; other files stay.)")
+        return answer == QtWidgets.QMessageBox.Yes
 
     def _attempt(self, title, action, done):
         """Run ``action()``; on bad input or an OS error show one message titled ``title``
