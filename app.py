@@ -55,6 +55,14 @@ def main(argv=None):
         print(f"saved {args.screenshot}")
         window.close()
         return 0
+    # Crash safety (rigedit.ui.autosave): a hard crash's stack goes to the log, a
+    # termination signal writes the recovery snapshot, and work left by an editor that is no
+    # longer running is offered once the window is up.
+    from rigedit.ui import autosave, errors_hook
+
+    errors_hook.enable_faulthandler()
+    notifier = autosave.install_signal_handlers(app, window)  # noqa: F841 - keep it alive
+    QtCore.QTimer.singleShot(0, lambda: autosave.offer_recovery(window))
     return app.exec_()
 
 

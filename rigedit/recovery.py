@@ -176,6 +176,7 @@ def write_entry(rig, pose, clip=None, time=0.0, original_path=None, folder=None)
     pose = np.asarray(pose, dtype=np.float64)
     if pose.shape != (len(rig.skeleton), 10):
         raise ValueError(f"expected a pose of {len(rig.skeleton)} joints, got {pose.shape}")
+    snap.mkdir()
     save_rig_folder(snap / "rig", rig)
     pid_text, _, start_text = folder.name.partition("-")
     write_json(snap / _INFO, {

@@ -24,9 +24,12 @@ import os
 import sys
 import traceback
 
+from PyQt5 import QtCore, QtWidgets
+
 from .. import recovery
 
-__all__ = ["install", "uninstall", "report", "describe", "logger", "enable_faulthandler"]
+__all__ = ["install", "uninstall", "report", "describe", "logger", "enable_faulthandler",
+           "ErrorDisplay"]
 
 _LOG = logging.getLogger("rigedit")
 _windows = []      # live editor windows, newest last
@@ -95,7 +98,8 @@ def _handle(exc_info, what):
     exc_type, exc, tb = exc_info
     summary = describe(exc_type, exc, tb)
     try:
-        logger().error("%s failed: %s", what or "Unexpected error", summary, exc_info=exc_info)
+        logger().error("%s: %s", f"{what} failed" if what else "Unexpected error", summary,
+                       exc_info=exc_info)
     except Exception:  # noqa: BLE001 - the hook itself must never raise
         pass
     shown = False
@@ -144,3 +148,51 @@ def enable_faulthandler():
     except OSError:
         return
     faulthandler.enable(file=_faults)
+
+
+class ErrorDisplay:
+    """How a window shows unexpected errors: a red label in the status bar that stays (the
+    status line itself is overwritten by the next "Posed knee_L") naming what failed, and one
+    non-modal dialog, reused while it is open, with a count.
+
+    Attributes
+    ----------
+    label : QLabel
+        The red status bar label (hidden until an error; hidden again when the dialog is
+        dismissed).
+    dialog : QMessageBox or None
+    count : int
+        Unexpected errors so far.
+    """
+
+    def __init__(self, window):
+        self.window = window
+        self.count = 0
+        self.dialog = None
+        self.label = QtWidgets.QLabel()
+        self.label.setStyleSheet("color: #ff6b6b; font-weight: bold")
+        self.label.setVisible(False)
+        window.statusBar().addPermanentWidget(self.label, 1)
+
+    def show(self, what, summary, saved=False):
+        what = what or "An operation"
+        log = recovery.log_path()
+        self.count += 1
+        self.label.setText(f"Error: {what} failed: {summary}")
+        self.label.setToolTip(f"Details in {log}")
+        self.label.setVisible(True)
+        self.window.statusBar().showMessage(f"Error: {what} failed; details in {log}")
+        text = (f"{what} failed unexpectedly:\n{summary}\n\n"
+                + ("Your work was written to a recovery file. " if saved else "")
+                + f"The details are in {log}.")
+        if self.count > 1:
+            text += f"\n\n({self.count} errors so far)"
+        box = self.dialog
+        if box is None or not box.isVisible():
+            box = QtWidgets.QMessageBox(QtWidgets.QMessageBox.Critical, "rigedit: error", "",
+                                        QtWidgets.QMessageBox.Ok, self.window)
+            box.setModal(False)  # the editor stays usable (and can be saved) behind it
+            box.finished.connect(lambda _: self.label.setVisible(False))
+            self.dialog = box
+        box.setText(text)
+        box.show()

@@ -13,7 +13,6 @@ import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 from pyvistaqt import QtInteractor
 
-from .. import recovery
 from ..document import Document
 from ..render.gizmos import AxisHandles, JointGizmos, gizmo_radius, overlay_renderer
 from ..render.scene import RigScene
@@ -87,8 +86,6 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         self.job = None
         self._pending_rebind = None  # (job, undo-stack top at its start, label)
         self.keep_recovery = False   # set when quitting on a signal: the entry must stay
-        self._error_dialog = None
-        self._error_count = 0
         self.gizmos = None
         self.axes = None
         self._drag = None
@@ -103,6 +100,7 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         self.document.subscribe(self._on_document)
         self._load_scene()
         self.autosave = Autosave(self)
+        self.error_display = errors_hook.ErrorDisplay(self)
         errors_hook.install(self)
         self.resize(1440, 900)
         self.status(note or f"Loaded {rig.name}: drag a joint sphere to pose; "
@@ -467,7 +465,6 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
 
     # ================================================================== messages
     def status(self, text, timeout=0):
-        self.statusBar().setStyleSheet("")
         self.statusBar().showMessage(text, timeout)
 
     def report_exception(self, what=None):
@@ -476,32 +473,12 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         errors_hook.report(what, sys.exc_info())
 
     def show_unexpected_error(self, what, summary):
-        """Show an unexpected error (a bug, not bad input): a red status message naming what
-        failed and one non-modal dialog (reused while open, with a count); the document is
-        written for recovery first, as the state after a bug may not be trustworthy."""
-        saved = self.autosave.crash_save() if hasattr(self, "autosave") else False
-        self._error_count += 1
-        what = what or "An operation"
-        log = recovery.log_path()
-        self.last_error = f"{what} failed: {summary}"
-        self.statusBar().showMessage(f"Error: {what} failed: {summary} — details in {log}")
-        self.statusBar().setStyleSheet("QStatusBar { color: #ff6b6b; font-weight: bold }")
-        text = (f"{what} failed unexpectedly:\n{summary}\n\n"
-                + ("Your work was written to a recovery file. " if saved else "")
-                + f"The details are in {log}.")
-        if self._error_count > 1:
-            text += f"\n\n({self._error_count} errors so far)"
-        box = self._error_dialog
-        if box is None or not box.isVisible():
-            box = QtWidgets.QMessageBox(QtWidgets.QMessageBox.Critical, "rigedit: error", "",
-                                        QtWidgets.QMessageBox.Ok, self)
-            box.setAttribute(QtCore.Qt.WA_DeleteOnClose)
-            box.destroyed.connect(lambda *_: setattr(self, "_error_dialog", None))
-            self._error_dialog = box
-            box.setText(text)
-            box.open()
-        else:
-            box.setText(text)
+        """Called by :mod:`.errors_hook` for a bug (not bad input): the document is written
+        for recovery first, as the state after a bug may not be trustworthy; then
+        :class:`~.errors_hook.ErrorDisplay` shows it."""
+        saved = self.autosave.crash_save()
+        self.last_error = f"{what or 'An operation'} failed: {summary}"
+        self.error_display.show(what, summary, saved)
 
     def error(self, title, message):
         """Show one clear message: a dialog (not blocking) and the status bar."""

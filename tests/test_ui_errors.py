@@ -1,0 +1,135 @@
+"""Errors are shown and logged, never lost: an exception in a Qt slot, a VTK observer or a
+job's completion callback reaches the user (a red status message naming what failed, a
+non-modal dialog) and the log file in the cache folder (with the traceback, which the status
+bar never shows); the editor keeps running and writes a recovery snapshot.
+
+pytest-qt normally installs its own excepthook for each test (and fails the test on any
+exception in a slot); these tests turn that off so the editor's hook is the one that runs.
+"""
+import sys
+import warnings
+
+import numpy as np
+import pytest
+
+pytestmark = [pytest.mark.ui, pytest.mark.qt_no_exception_capture]
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    return tmp_path / "cache" / "rigedit"
+
+
+@pytest.fixture
+def editor(cache, qtbot):
+    """A window on the small code-built creature, with the cache folder in tmp_path."""
+    from rigedit.ui import MainWindow
+    from rigedit.ui.fallback import demo_rig
+
+    hook = sys.excepthook
+    w = MainWindow(demo_rig())
+    qtbot.addWidget(w)
+    w.show()
+    qtbot.waitExposed(w)
+    assert sys.excepthook is not hook  # the editor's hook is installed ...
+    yield w
+    w.close()
+    assert sys.excepthook is hook  # ... and the previous one back after close
+
+
+def _log(cache):
+    return (cache / "rigedit.log").read_text()
+
+
+def _status(w):
+    return w.statusBar().currentMessage()
+
+
+def test_exception_in_a_qt_slot_is_shown_logged_and_saved(editor, cache, monkeypatch):
+    doc = editor.document
+    doc.set_joint_euler(3, [20, 0, 0])  # unsaved work
+
+    def broken(*args, **kwargs):
+        raise ZeroDivisionError("the pose exploded")
+
+    monkeypatch.setattr(doc, "edit_pose", broken)
+    editor.joint_panel.reset_pose_button.click()  # its slot, Document.reset_pose, raises
+    shown = editor.error_display.label
+    assert shown.isVisible() and "ff6b6b" in shown.styleSheet()  # red, in the status bar
+    assert "ZeroDivisionError: the pose exploded" in shown.text()
+    assert "reset_pose" in shown.text() and "document.py" in shown.text()  # where it failed
+    assert "Traceback" not in shown.text() and "Traceback" not in _status(editor)
+    assert str(cache / "rigedit.log") in _status(editor)
+    box = editor.error_display.dialog
+    assert box.isVisible() and not box.isModal()
+    assert "the pose exploded" in box.text() and "recovery" in box.text()
+    log = _log(cache)
+    assert "Traceback (most recent call last)" in log and "def broken" not in log
+    assert "raise ZeroDivisionError" in log and "reset_pose" in log
+    # The editor goes on: the work is still there and written for recovery.
+    assert editor.isVisible() and doc.modified
+    from rigedit import recovery
+
+    [entry] = recovery.list_entries()
+    np.testing.assert_array_equal(np.array(entry.info["pose"]), doc.pose_snapshot())
+    # A second failure reuses the dialog and counts.
+    editor.joint_panel.reset_pose_button.click()
+    assert editor.error_display.dialog is box and "2 errors so far" in box.text()
+    editor.status("Posed neck")  # later messages do not hide the error ...
+    assert shown.isVisible()
+    box.accept()  # ... until the user dismissed it
+    assert not shown.isVisible()
+
+
+def test_exception_in_a_vtk_observer_is_shown_not_warned(editor, cache, monkeypatch):
+    def broken(j, target):
+        raise RuntimeError("IK diverged")
+
+    monkeypatch.setattr(editor, "drag_step", broken)
+    w = editor.gizmos.widgets[4]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        w.InvokeEvent("StartInteractionEvent")
+        w.SetCenter(*(np.array(w.GetCenter()) + 0.1))
+        w.InvokeEvent("InteractionEvent")
+        w.InvokeEvent("EndInteractionEvent")
+    assert [c for c in caught if issubclass(c.category, RuntimeWarning)] == []
+    assert "joint gizmo callback failed: RuntimeError: IK diverged" in \
+        editor.error_display.label.text()
+    assert "RuntimeError: IK diverged" in _log(cache)
+    # gizmos.errors still holds it, so the UI window fixture fails a test when this happens.
+    assert len(editor.gizmos.errors) == 1 and "IK diverged" in editor.gizmos.errors[0]
+    assert editor.gizmos.active is None  # the end of the drag still ran
+
+
+def test_exception_in_a_job_completion_callback(editor, cache, qtbot):
+    def done(result):
+        raise TypeError(f"cannot apply {result}")
+
+    job = editor.run_job("Applying thing", lambda report: 42, done)
+    assert job is not None
+    qtbot.waitUntil(lambda: editor.job is None, timeout=10000)
+    assert "Applying thing failed: TypeError: cannot apply 42" in \
+        editor.error_display.label.text()
+    assert not editor.progress.isVisible() and not editor.cancel_button.isVisible()
+    assert "cannot apply 42" in _log(cache) and "Traceback" in _log(cache)
+    # Bad input (a ValueError) stays a plain message, not a bug report.
+    job = editor.run_job("Reading", lambda report: 1,
+                         lambda r: (_ for _ in ()).throw(ValueError("x.json: expected a list")))
+    qtbot.waitUntil(lambda: editor.job is None, timeout=10000)
+    assert editor.last_error == "x.json: expected a list"
+    editor._last_dialog.close()
+
+
+def test_unexpected_exception_in_a_worker_is_logged_not_printed(editor, cache, qtbot, capfd):
+    def work(report):
+        return 1 / 0
+
+    editor.run_job("Crunching", work, lambda r: None)
+    qtbot.waitUntil(lambda: editor.job is None, timeout=10000)
+    assert "unexpected ZeroDivisionError" in editor.last_error
+    assert "details in the log" in editor.last_error
+    assert "1 / 0" in _log(cache)
+    assert "Traceback" not in capfd.readouterr().err
+    editor._last_dialog.close()
