@@ -5,7 +5,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import pytest
 
-# The editor window fixture (`window`, `rig_template`) for the UI tests.
+# The editor window fixture (`window`, `demo_window`, `rig_template`) for the UI tests.
 pytest_plugins = ["ui_window_fixture"]
 
 from builders import cylinder_rig
@@ -21,7 +21,7 @@ def cyl_rig():
 # missing they must FAIL, never skip: a skipped UI suite looks green. pytest-xvfb itself only
 # prints a note when Xvfb is not installed and runs on whatever DISPLAY there is (or none, and
 # then Qt aborts the whole process), so check here, before any fixture creates a QApplication.
-UI_FIXTURES = {"qtbot", "qapp", "window"}
+UI_FIXTURES = {"qtbot", "qapp", "window", "demo_window"}
 UI_PROBLEM = pytest.StashKey[object]()
 
 

@@ -2,8 +2,10 @@
 
 It opens the bundled quadruped and nothing else: when that rig cannot be loaded the fixture
 fails with the loader's message rather than testing some other rig. (Tests that want the
-small code-built creature for speed build their own window on ``demo_rig()``.)
+small code-built creature for speed use ``demo_window``.)
 """
+from contextlib import contextmanager
+
 import pytest
 
 import rigedit
@@ -20,23 +22,18 @@ def rig_template():
         pytest.fail(f"the UI tests' rig {RIG!r} did not load: {exc}", pytrace=False)
 
 
-@pytest.fixture
-def window(qtbot, rig_template):
-    """The main window on the default rig, reset to its bundled rest state; fails the test
-    when a VTK callback raised."""
+@contextmanager
+def editor_window(qtbot, rig, size=(1100, 750)):
+    """A shown main window on ``rig``; on exit it is closed, and the test fails when a VTK
+    callback raised meanwhile."""
     from threadpoolctl import threadpool_limits
 
     from rigedit.ui import MainWindow
 
-    rig = rig_template
-    # Every test starts from the bundled rest state and place (tests edit the rig in place,
-    # File > Save As moves it).
-    rig.skeleton, rig.binding, rig.path = _ORIGINAL.setdefault(
-        id(rig), (rig.skeleton, rig.binding, rig.path))
     with threadpool_limits(1):
         w = MainWindow(rig)
         qtbot.addWidget(w)
-        w.resize(1100, 750)
+        w.resize(*size)
         w.show()
         qtbot.waitExposed(w)
         w.plotter.render()
@@ -44,6 +41,41 @@ def window(qtbot, rig_template):
         errors = list(w.gizmos.errors)
         w.close()
     assert errors == [], "exceptions in VTK callbacks:\n" + "\n".join(errors)
+
+
+@pytest.fixture
+def window(qtbot, rig_template):
+    """The main window on the bundled quadruped, reset to its bundled rest state."""
+    rig = rig_template
+    # Every test starts from the bundled rest state and place (tests edit the rig in place,
+    # File > Save As moves it).
+    rig.skeleton, rig.binding, rig.path = _ORIGINAL.setdefault(
+        id(rig), (rig.skeleton, rig.binding, rig.path))
+    with editor_window(qtbot, rig) as w:
+        yield w
+
+
+@pytest.fixture
+def demo_window(qtbot):
+    """The main window on the small code-built creature (``demo_rig()``, 19 joints), chosen
+    for speed where the rig does not matter."""
+    from rigedit.ui.fallback import demo_rig
+
+    with editor_window(qtbot, demo_rig()) as w:
+        yield w
+
+
+def menu_action(window, menu, text):
+    """The action ``text`` (without '&' and '...') of the window's menu ``menu``."""
+    def clean(t):
+        return t.replace("&", "").rstrip(".").strip()
+
+    for top in window.menuBar().actions():
+        if clean(top.text()) == menu:
+            for act in top.menu().actions():
+                if clean(act.text()) == text:
+                    return act
+    pytest.fail(f"expected an action {text!r} in the {menu} menu", pytrace=False)
 
 
 def limb_joint(sk, name="fore_cannon_L"):
