@@ -7,18 +7,13 @@ from scipy.spatial.transform import Rotation
 
 pytestmark = [pytest.mark.ui, pytest.mark.filterwarnings("error::RuntimeWarning")]
 
-from PyQt5 import QtCore, QtGui, QtWidgets  # noqa: E402
+from PyQt5 import QtCore, QtWidgets  # noqa: E402
 
-from ui_window_fixture import limb_joint  # noqa: E402
+from ui_window_fixture import limb_joint, send_mouse  # noqa: E402
 
 
 def _mouse(widget, kind, pos):
-    types = {"press": QtCore.QEvent.MouseButtonPress, "move": QtCore.QEvent.MouseMove,
-             "release": QtCore.QEvent.MouseButtonRelease}
-    buttons = QtCore.Qt.NoButton if kind == "release" else QtCore.Qt.LeftButton
-    ev = QtGui.QMouseEvent(types[kind], QtCore.QPointF(pos), QtCore.Qt.LeftButton, buttons,
-                           QtCore.Qt.NoModifier)
-    QtWidgets.QApplication.sendEvent(widget, ev)
+    send_mouse(widget, kind, pos.x(), pos.y())
 
 
 def _handle_center(slider):

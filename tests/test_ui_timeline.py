@@ -10,9 +10,12 @@ from scipy.spatial.transform import Rotation
 
 pytestmark = [pytest.mark.ui, pytest.mark.filterwarnings("error::RuntimeWarning")]
 
-from PyQt5 import QtCore, QtGui, QtWidgets  # noqa: E402
+from PyQt5 import QtCore, QtWidgets  # noqa: E402
 
 from rigedit.animation import Clip, Track  # noqa: E402
+
+from ui_window_fixture import editor_window  # noqa: E402
+from ui_window_fixture import send_mouse as _mouse  # noqa: E402
 
 
 def _rig():
@@ -30,27 +33,8 @@ def _rig():
 
 @pytest.fixture
 def window(qtbot):
-    from threadpoolctl import threadpool_limits
-
-    from rigedit.ui import MainWindow
-
-    with threadpool_limits(1):
-        w = MainWindow(_rig())
-        qtbot.addWidget(w)
-        w.resize(1000, 700)
-        w.show()
-        qtbot.waitExposed(w)
+    with editor_window(qtbot, _rig(), size=(1000, 700)) as w:
         yield w
-        w.close()
-
-
-def _mouse(widget, kind, x, y):
-    types = {"press": QtCore.QEvent.MouseButtonPress, "move": QtCore.QEvent.MouseMove,
-             "release": QtCore.QEvent.MouseButtonRelease}
-    buttons = QtCore.Qt.NoButton if kind == "release" else QtCore.Qt.LeftButton
-    ev = QtGui.QMouseEvent(types[kind], QtCore.QPointF(x, y), QtCore.Qt.LeftButton, buttons,
-                           QtCore.Qt.NoModifier)
-    QtWidgets.QApplication.sendEvent(widget, ev)
 
 
 def _row_y(ruler, row):

@@ -85,3 +85,16 @@ def limb_joint(sk, name="fore_cannon_L"):
         pytest.fail(f"expected a joint {name!r} in the test rig, got {', '.join(sk.names)}",
                     pytrace=False)
     return sk.index[name]
+
+
+def send_mouse(widget, kind, x, y):
+    """Send a left-button "press", "move" (button held) or "release" at (x, y) to a Qt
+    widget."""
+    from PyQt5 import QtCore, QtGui, QtWidgets
+
+    types = {"press": QtCore.QEvent.MouseButtonPress, "move": QtCore.QEvent.MouseMove,
+             "release": QtCore.QEvent.MouseButtonRelease}
+    buttons = QtCore.Qt.NoButton if kind == "release" else QtCore.Qt.LeftButton
+    ev = QtGui.QMouseEvent(types[kind], QtCore.QPointF(x, y), QtCore.Qt.LeftButton, buttons,
+                           QtCore.Qt.NoModifier)
+    QtWidgets.QApplication.sendEvent(widget, ev)
