@@ -145,7 +145,15 @@ def read_clips(data, skeleton, smap, warning):
                 continue
             tracks[(skeleton.names[j], target.path)] = _channel_track(
                 data, a, anim, channel, ci, smap.prefix[j])
-        clips[name] = Clip(name, skeleton, tracks, loop=True)
+        # rigedit's own exports keep the clip's length and loop flag in the animation's extras
+        own = anim.extras.get("rigedit") if isinstance(anim.extras, dict) else None
+        own = own if isinstance(own, dict) else {}
+        duration = own.get("duration")
+        last = max((tr.times[-1] for tr in tracks.values()), default=0.0)
+        if not isinstance(duration, (int, float)) or not last <= duration < 1e9:
+            duration = None
+        clips[name] = Clip(name, skeleton, tracks, duration=duration,
+                           loop=bool(own.get("loop", True)))
     if off_skeleton:
         warnings.warn(f"{data.path}: skipped animation channels on {len(off_skeleton)} nodes "
                       f"that are not joints of the skin (nodes {sorted(off_skeleton)[:8]})",
