@@ -232,14 +232,25 @@ def foot_slide(rig, clip_name, foot_joints, fps=120, contact=0.012, touch=0.003)
     return lowest, grounded, frac
 
 
+# Limits about 1.5x what the bundled clips measure now (foot_slide at 120 samples/s), so a
+# regression in the clips or the weights shows; the measured value is beside each limit.
+HOOVES = [f"{p}_hoof_{s}" for p in ("hind", "fore") for s in "LR"]
+
+
 def test_quadruped_walk_hooves_stay_planted(quad):
-    hooves = [f"{p}_hoof_{s}" for p in ("hind", "fore") for s in "LR"]
-    lowest, grounded, frac = foot_slide(quad, "walk", hooves)
-    length = np.ptp(quad.vertices[:, 2])
-    assert lowest < 0.02 * length, f"hoof slides {lowest * 1000:.1f} mm"
-    assert grounded < 0.02 * length, f"hoof skates {grounded * 1000:.1f} mm"
-    for f, x in frac.items():   # a walk: each hoof on the ground more than half the time
-        assert 0.5 < x < 0.85, (f, x)
+    lowest, grounded, frac = foot_slide(quad, "walk", HOOVES)
+    assert lowest < 0.0020, f"hoof slides {lowest * 1000:.2f} mm"      # measured 1.34 mm
+    assert grounded < 0.0036, f"hoof skates {grounded * 1000:.2f} mm"  # measured 2.37 mm
+    for f, x in frac.items():   # duty factor of the walk: measured 0.655-0.669 (built 0.62)
+        assert 0.62 < x < 0.70, (f, x)
+
+
+def test_quadruped_run_hooves_stay_planted(quad):
+    lowest, grounded, frac = foot_slide(quad, "run", HOOVES)
+    assert lowest < 0.0034, f"hoof slides {lowest * 1000:.2f} mm"      # measured 2.24 mm
+    assert grounded < 0.020, f"hoof skates {grounded * 1000:.2f} mm"   # measured 13.36 mm
+    for f, x in frac.items():   # duty factor of the trot: measured 0.452-0.466 (built 0.4)
+        assert 0.42 < x < 0.50, (f, x)
 
 
 def test_quadruped_walk_is_four_beat(quad):
@@ -264,25 +275,37 @@ def test_quadruped_walk_is_four_beat(quad):
     assert order[start:] + order[:start] == ["hind_hoof_L", "fore_hoof_L", "hind_hoof_R",
                                                "fore_hoof_R"]
     gaps = np.diff(sorted(down.values()))
+    # measured: gaps 0.267, 0.233, 0.267 (4 of the 240 samples off a quarter)
     assert np.allclose(gaps, 0.25, atol=0.02), down
 
 
 def test_humanoid_walk_feet_stay_planted(human):
     feet = ["LeftFoot", "RightFoot", "LeftToeBase", "RightToeBase"]
     lowest, grounded, frac = foot_slide(human, "walk", feet)
-    assert lowest < 0.02 * 1.75, f"foot slides {lowest * 1000:.1f} mm"
-    assert grounded < 0.02 * 1.75, f"foot skates {grounded * 1000:.1f} mm"
-    for f in ("LeftToeBase", "RightToeBase"):
-        assert 0.4 < frac[f] < 0.8, (f, frac[f])
+    assert lowest < 0.0028, f"foot slides {lowest * 1000:.2f} mm"      # measured 1.89 mm
+    assert grounded < 0.0083, f"foot skates {grounded * 1000:.2f} mm"  # measured 5.56 mm
+    for f in ("LeftToeBase", "RightToeBase"):   # ball of the foot down: measured 0.684-0.692
+        assert 0.64 < frac[f] < 0.74, (f, frac[f])
+
+
+# Measured over 7 samples of every clip: the worst stretch of one mesh edge (posed minus rest
+# length) and the 99.9th percentile of posed/rest edge length. The worst edges are where
+# linear blend skinning tears between regions that never mix: the quadruped's right armpit in
+# the run (spine_2/3 against fore_upper_R: 7 mm -> 98 mm), the humanoid's crotch in the walk
+# (LeftUpLeg against RightUpLeg: 4 mm -> 84 mm). Limits 1.5x the measured values.
+EDGE_LIMITS = {"quadruped": (0.127, 9.9),   # measured 84.4 mm, 6.59
+               "humanoid": (0.119, 4.3)}    # measured 79.2 mm, 2.88
 
 
 def test_skinning_keeps_limbs_attached(rig):
-    """No vertex flies off: at every sampled frame each skinned vertex stays near the
-    skinned position of its neighbours (no spikes), and the mesh keeps its size."""
-    e = np.concatenate([rig.faces[:, [0, 1]], rig.faces[:, [1, 2]]])
+    """No vertex flies off: in every sampled frame the mesh's edges stretch no more than
+    they do today."""
+    e = np.concatenate([rig.faces[:, [0, 1]], rig.faces[:, [1, 2]], rig.faces[:, [2, 0]]])
     rest_len = np.linalg.norm(rig.vertices[e[:, 0]] - rig.vertices[e[:, 1]], axis=1)
+    max_stretch, max_ratio = EDGE_LIMITS[rig.name]
     for clip in rig.clips.values():
         for t in np.linspace(0, clip.duration, 7):
             v = rig.skin(clip.sample(t))
             length = np.linalg.norm(v[e[:, 0]] - v[e[:, 1]], axis=1)
-            assert length.max() < 4 * rest_len.max() + 0.01, (clip.name, t)
+            assert (length - rest_len).max() < max_stretch, (clip.name, t)
+            assert np.percentile(length / rest_len, 99.9) < max_ratio, (clip.name, t)
