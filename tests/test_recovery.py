@@ -11,11 +11,7 @@ import pytest
 from rigedit import recovery
 from rigedit.document import Document
 
-
-@pytest.fixture
-def cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
-    return tmp_path / "cache" / "rigedit"
+from cache_fixture import cache  # noqa: E402,F401 - the fixture
 
 
 def test_cache_folder_follows_xdg(tmp_path, monkeypatch):

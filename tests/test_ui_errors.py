@@ -14,11 +14,7 @@ import pytest
 
 pytestmark = [pytest.mark.ui, pytest.mark.qt_no_exception_capture]
 
-
-@pytest.fixture
-def cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
-    return tmp_path / "cache" / "rigedit"
+from cache_fixture import cache  # noqa: E402,F401 - the fixture
 
 
 @pytest.fixture
