@@ -1,7 +1,9 @@
 """The ``rigedit`` command: headless jobs on rigs (info, list, weights, render).
 
 Bad input (a missing or malformed file, an unknown clip or joint) prints one line naming the
-file and the problem and exits with status 2; no traceback.
+file and the problem and exits with status 2; no traceback. An output in a folder that does
+not exist is bad input, found before any work. Ctrl-C or SIGTERM removes the output's
+temporary file, prints one line and exits with 130 or 143 (see :mod:`rigedit.cli_output`).
 """
 from __future__ import annotations
 
@@ -185,12 +187,19 @@ def build_parser():
 def main(argv=None):
     """Entry point; returns the exit status."""
     os.environ.setdefault("OMP_NUM_THREADS", "1")
+    from .cli_output import Interrupted, check_output, interruptible
     from .errors import RigFileError
 
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return args.func(args)
+        with interruptible():
+            if getattr(args, "output", None) is not None:
+                check_output(args.output, folder_ok=args.func is cmd_export)
+            return args.func(args)
+    except Interrupted as exc:
+        print(f"rigedit: interrupted by {exc}", file=sys.stderr)
+        return exc.exit_status
     except (RigFileError, UsageError) as exc:
         print(f"rigedit: error: {exc}", file=sys.stderr)
     except KeyError as exc:  # unknown joint

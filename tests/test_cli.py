@@ -1,5 +1,9 @@
+import os
+import signal
 import subprocess
 import sys
+import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -75,3 +79,84 @@ def test_render_end_to_end_mp4_and_gif(rig_dir, tmp_path):
                  "--duration", "0.5", "--size", "64x48", "--angle", "90", "-q"]) == 0
     g = iio.imread(gif)
     assert g.shape[0] == 2 and g.shape[1:3] == (48, 64)
+
+
+# ---------------------------------------------------------------------- output files
+@pytest.mark.parametrize("argv", [
+    ["weights", "{rig}", "-o", "{out}/w.npz"],
+    ["render", "bend", "--rig", "{rig}", "-o", "{out}/v.mp4", "-q"],
+    ["export", "{rig}", "-o", "{out}/copy"],
+])
+def test_missing_output_folder_is_one_error_for_every_command(rig_dir, tmp_path, capsys, argv):
+    out = tmp_path / "no" / "such"
+    argv = [a.format(rig=rig_dir, out=out) for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith(f"rigedit: error: {argv[argv.index('-o') + 1]}:")
+    assert "expected an existing folder" in err[0]
+    assert not (tmp_path / "no").exists()   # no folder created
+
+
+def _hidden(folder):
+    return [p.name for p in Path(folder).iterdir() if p.name.startswith(".")]
+
+
+@pytest.mark.parametrize("argv", [
+    ["weights", "{rig}", "-o", "{out}"],
+    ["render", "bend", "--rig", "{rig}", "-o", "{out}", "-q", "--size", "32x32", "--fps", "2"],
+])
+def test_output_that_cannot_be_written_is_named_not_its_temporary_file(rig_dir, tmp_path,
+                                                                        capsys, argv):
+    """An output path that is an existing folder: the error names it, no temp file stays."""
+    out = tmp_path / "taken" / ("w.npz" if argv[0] == "weights" else "v.mp4")
+    out.mkdir(parents=True)
+    assert main([a.format(rig=rig_dir, out=out) for a in argv]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith(f"rigedit: error: {out}:"), err
+    assert f".{out.name}." not in err[0]
+    assert _hidden(out.parent) == []
+
+
+def test_atomic_write_errors_name_the_target_not_the_temporary_file(tmp_path):
+    from rigedit.io.atomic import write_json
+
+    target = tmp_path / "x.json"
+    target.mkdir()
+    with pytest.raises(OSError) as info:
+        write_json(target, {})
+    assert info.value.filename == str(target) and _hidden(tmp_path) == []
+
+
+def _start_render(rig_dir, out, extra=()):
+    """A ``rigedit render`` long enough to interrupt (thousands of tiny frames), started in
+    its own session, headless (no DISPLAY: the recorder renders through EGL)."""
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    return subprocess.Popen(
+        [sys.executable, "-m", "rigedit", "render", "bend", "--rig", str(rig_dir), "-o",
+         str(out), "--size", "32x32", "--fps", "60", "--duration", "300", "-q", *extra],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+        env=env)
+
+
+def test_interrupted_render_removes_its_temporary_file(rig_dir, tmp_path):
+    """Ctrl-C (SIGINT to the whole process group, ffmpeg too) and SIGTERM (to the process)
+    in the middle of MP4 and GIF renders: exit 130/143, one line, no temporary file left."""
+    cases = [(signal.SIGINT, ".mp4", True), (signal.SIGTERM, ".gif", False),
+             (signal.SIGTERM, ".mp4", False)]
+    runs = []
+    for i, (sig, suffix, group) in enumerate(cases):   # started together: startup dominates
+        out = tmp_path / f"out{i}" / f"v{suffix}"
+        out.parent.mkdir()
+        runs.append((sig, group, out, _start_render(rig_dir, out)))
+    for sig, group, out, proc in runs:
+        deadline = time.monotonic() + 120
+        while not _hidden(out.parent) and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert proc.poll() is None and _hidden(out.parent), "the render did not start writing"
+        time.sleep(0.3)   # some frames in
+        (os.killpg if group else os.kill)(proc.pid, sig)
+    for sig, group, out, proc in runs:
+        _, err = proc.communicate(timeout=60)
+        assert proc.returncode == 128 + sig
+        assert err.splitlines() == [f"rigedit: interrupted by {signal.Signals(sig).name}"], err
+        assert list(out.parent.iterdir()) == []   # no temporary file, no output

@@ -15,7 +15,7 @@ from pathlib import Path
 from ..errors import RigFileError
 
 __all__ = ["atomic_write", "write_json", "temp_beside", "check_output_folder",
-           "fsync_folder"]
+           "fsync_folder", "naming_target"]
 
 
 def check_output_folder(path):
@@ -42,7 +42,7 @@ def fsync_folder(folder):
         os.close(fd)
 
 
-def _rename_error(exc, tmp, path):
+def naming_target(exc, tmp, path):
     """``exc`` as the same OSError naming ``path`` where it named the temporary file."""
     if isinstance(exc, OSError) and exc.filename in (str(tmp), tmp):
         new = type(exc)(exc.errno, exc.strerror, str(path))
@@ -92,7 +92,7 @@ def atomic_write(path, mode="w", suffix=None):
     except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
-        new = _rename_error(exc, tmp, path)
+        new = naming_target(exc, tmp, path)
         if new is exc:
             raise
         raise new from None

@@ -1,0 +1,66 @@
+"""Output files of the ``rigedit`` command: checked before any work, and never left half
+written when the run is interrupted.
+
+- :func:`check_output` refuses, up front and with the user's path in the message, an output
+  whose folder does not exist (no command creates folders) or a file output that is a folder.
+- :func:`interruptible` turns SIGINT (Ctrl-C) and SIGTERM into an :class:`Interrupted`
+  exception, so the writers' clean-up (``finally`` blocks that delete their temporary file)
+  runs; the command then prints one line and exits with 128 + the signal number (130, 143).
+"""
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from pathlib import Path
+
+from .errors import RigFileError
+from .io.atomic import check_output_folder
+
+__all__ = ["Interrupted", "interruptible", "check_output"]
+
+
+class Interrupted(BaseException):
+    """The run got SIGINT or SIGTERM. A ``BaseException``, like ``KeyboardInterrupt``, so that
+    ``except Exception`` in the middle of a job does not swallow it."""
+
+    def __init__(self, signum):
+        self.signum = signum
+        super().__init__(signal.Signals(signum).name)
+
+    @property
+    def exit_status(self):
+        return 128 + self.signum
+
+
+def _raise_interrupted(signum, frame):
+    # Further signals are ignored while the clean-up runs, so a second Ctrl-C cannot leave
+    # the temporary file behind.
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, signal.SIG_IGN)
+    raise Interrupted(signum)
+
+
+@contextlib.contextmanager
+def interruptible():
+    """Within the block, SIGINT and SIGTERM raise :class:`Interrupted` (main thread only);
+    the previous handlers are restored afterwards."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {sig: signal.signal(sig, _raise_interrupted)
+                for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def check_output(path, folder_ok=False):
+    """``RigFileError`` naming ``path`` unless it can be written: its folder exists, and it is
+    not an existing folder (unless ``folder_ok``: an output that is itself a folder)."""
+    path = Path(path)
+    check_output_folder(path)
+    if path.is_dir() and not folder_ok:
+        raise RigFileError(path, "expected a file name to write, got a folder")
