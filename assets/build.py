@@ -42,9 +42,8 @@ def main(argv):
         t0 = time.time()
         rig = BUILDERS[name]()
         out = HERE / name
-        if (out / "animations").is_dir():  # a clip removed from the build must not linger
-            for old in (out / "animations").glob("*.json"):
-                old.unlink()
+        # the folder is the build's: a clip removed from the build loses its file (rig.json
+        # lists the clip files the previous build wrote)
         save_rig_folder(out, rig, allow_bundled=True)
         print(f"{name}: built in {time.time() - t0:.1f} s -> {out}")
 

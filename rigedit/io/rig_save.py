@@ -216,7 +216,7 @@ def save_rig_folder_atomic(folder, rig, mesh_name="mesh.obj", allow_bundled=Fals
                      rig.skeleton.names)
         for clip in rig.clips.values():
             save_clip(stage / ANIMATIONS / files[clip.name], clip)
-        clip_paths = {name: f"{ANIMATIONS}/{f}" for name, f in files.items()}
+        clip_paths = {name: f"{ANIMATIONS}/{files[name]}" for name in sorted(files)}
         write_json(stage / "rig.json", {"name": rig.name, "mesh": mesh_name,
                                         "skeleton": "skeleton.json", "weights": "weights.npz",
                                         "up": rig.up, "clips": clip_paths})
