@@ -70,10 +70,12 @@ class Rig:
         """(J, 4, 4) model-space joint matrices of ``pose``."""
         return local_to_model(self.skeleton, pose)
 
-    def skin(self, pose, out=None):
-        """(V, 3) skinned vertex positions of ``pose`` (a new float64 array unless ``out``)."""
+    def skin(self, pose, out=None, method="lbs"):
+        """(V, 3) skinned vertex positions of ``pose`` (a new float64 array unless ``out``);
+        ``method`` is ``"lbs"`` (linear blend) or ``"dqs"`` (dual quaternions, see
+        :mod:`rigedit.model.dqs`)."""
         palette = skinning_matrices(self.skeleton, self.joint_matrices(pose))
-        res = self.binding.skin(palette)
+        res = self.binding.skin(palette, method=method)
         if out is None:
             return res.astype(np.float64)
         out[:] = res

@@ -1,15 +1,30 @@
-"""Linear blend skinning with a binding precomputed once so that a frame is one sparse product."""
+"""Skinning with a binding precomputed once: linear blend (LBS) and dual quaternions (DQS).
+
+Two paths compute the same thing: compiled numba kernels (:mod:`.skinning_kernels`, one pass
+over the vertices, used once compiled in the background) and numpy (the reference and the
+fallback: for LBS one sparse product, for DQS :func:`.dqs.dqs_skin`).
+"""
 from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
+
+from . import skinning_kernels
+from .dqs import dqs_skin, palette_dual_quaternions
 
 try:  # The in-place kernel behind ``csr_matrix @ dense``; lets a frame reuse its buffers.
     from scipy.sparse._sparsetools import csr_matvecs as _csr_matvecs
 except ImportError:  # pragma: no cover - SciPy moved it; fall back to the public product
     _csr_matvecs = None
 
-__all__ = ["SkinBinding", "linear_blend_skin", "top_k_influences", "dense_weights"]
+__all__ = ["SkinBinding", "linear_blend_skin", "top_k_influences", "dense_weights", "METHODS",
+           "BACKENDS"]
+
+#: Skinning methods: linear blend, dual quaternion.
+METHODS = ("lbs", "dqs")
+#: Where a frame is computed: None picks the compiled kernels once they are loaded, numpy
+#: until then; "numba" waits for the kernels (raises when they cannot load); "numpy".
+BACKENDS = (None, "numba", "numpy")
 
 
 def top_k_influences(weights, k):
@@ -69,10 +84,12 @@ class SkinBinding:
 
     Notes
     -----
-    The weights are held as a sparse (V, J) float32 matrix ``W`` (``matrix``). A frame computes
-    ``B = W · P`` where ``P`` is (J, 12), each joint's skinning matrix's top three rows, which
-    gives every vertex its blended 3x4 matrix; then applies it to the rest vertex. Both results
-    go into buffers allocated here, once.
+    The compiled kernels read the (V, K) influences as float32 weights and int32 indices and
+    blend each vertex's K skinning matrices in registers. The numpy path holds the weights as
+    a sparse (V, J) float32 matrix ``W`` (``matrix``): a frame computes ``B = W · P`` where
+    ``P`` is (J, 12), each joint's skinning matrix's top three rows, which gives every vertex
+    its blended 3x4 matrix, then applies it to the rest vertex. Every per-frame buffer is
+    allocated here, once.
     """
 
     def __init__(self, rest_vertices, indices, weights, num_joints):
@@ -109,6 +126,14 @@ class SkinBinding:
         self._blend = np.empty((v, 12), dtype=np.float32)
         self._out = np.empty((v, 3), dtype=np.float32)
         self._tmp = np.empty((v, 3), dtype=np.float32)
+        # The kernels' inputs: C-contiguous float32 / int32, the exact compiled signature.
+        self._indices32 = np.ascontiguousarray(self.indices, dtype=np.int32)
+        self._weights32 = np.ascontiguousarray(self.weights, dtype=np.float32)
+        self._dq = np.empty((self.num_joints, 8), dtype=np.float32)
+        self._scale = np.empty((self.num_joints, 9), dtype=np.float32)
+        #: Threads of the compiled kernels: None picks one for small meshes, all for big ones
+        #: (see ``skinning_kernels.PARALLEL_MIN_VERTICES``).
+        self.threads = None
 
     @property
     def num_vertices(self):
@@ -118,7 +143,29 @@ class SkinBinding:
         """(V, J) float64 weights."""
         return dense_weights(self.indices, self.weights, self.num_joints)
 
-    def skin(self, palette, out=None):
+    def _kernels(self, backend):
+        """The compiled kernels to use for ``backend``, or None for the numpy path."""
+        if backend not in BACKENDS:
+            raise ValueError(f"expected a skinning backend in {BACKENDS}, got {backend!r}")
+        if backend == "numpy":
+            return None
+        if backend == "numba":
+            kernels = skinning_kernels.load()
+            if kernels is None:
+                raise RuntimeError(f"the compiled skinning kernels are not available "
+                                   f"({skinning_kernels.error()})")
+            return kernels
+        skinning_kernels.start_loading()
+        return skinning_kernels.ready()
+
+    def _output(self, out):
+        if out is None:
+            return self._out
+        if out.shape != self._out.shape:
+            raise ValueError(f"expected out of shape {self._out.shape}, got {out.shape}")
+        return out
+
+    def skin(self, palette, out=None, method="lbs", backend=None):
         """Skinned vertex positions for a palette of skinning matrices.
 
         Parameters
@@ -128,12 +175,26 @@ class SkinBinding:
         out : (V, 3) array, optional
             Where to write; by default an internal float32 buffer that the next call
             overwrites (copy it to keep it).
+        method : {"lbs", "dqs"}
+            Linear blend or dual-quaternion skinning (:meth:`skin_dqs`).
+        backend : {None, "numba", "numpy"}
+            See ``BACKENDS``; None uses the compiled kernels once they are loaded.
 
         Returns
         -------
-        vertices : (V, 3) float32
+        vertices : (V, 3) float32 (or ``out``)
         """
+        if method == "dqs":
+            return self.skin_dqs(palette, out=out, backend=backend)
+        if method != "lbs":
+            raise ValueError(f"expected a skinning method in {METHODS}, got {method!r}")
+        kernels = self._kernels(backend)
         self._palette[:] = np.asarray(palette)[:, :3, :].reshape(-1, 12)
+        res = self._output(out)
+        if kernels is not None and res.dtype == np.float32 and res.flags.c_contiguous:
+            kernels.run("lbs", len(res), self.threads, self._rest32, self._indices32,
+                        self._weights32, self._palette, res)
+            return res
         blend = self._blend
         w = self.matrix
         if _csr_matvecs is not None:
@@ -143,7 +204,6 @@ class SkinBinding:
         else:
             blend[:] = w @ self._palette
         b = blend.reshape(-1, 3, 4)
-        res = self._out if out is None else out
         # res = b[:, :, :3] @ rest + b[:, :, 3], written column by column into the buffers to
         # avoid the (V, 3, 3) temporaries an einsum would make.
         r = self._rest32
@@ -154,6 +214,35 @@ class SkinBinding:
         np.multiply(b[:, :, 2], r[:, 2:3], out=tmp)
         res += tmp
         res += b[:, :, 3]
+        return res
+
+    def skin_dqs(self, palette, out=None, backend=None):
+        """Dual-quaternion skinned vertex positions (see :mod:`rigedit.model.dqs` for the
+        antipodality and scale handling).
+
+        Parameters
+        ----------
+        palette : (J, 4, 4) float
+            Skinning matrices ``M_j · inverse_bind_j``.
+        out : (V, 3) array, optional
+            As in :meth:`skin`.
+        backend : {None, "numba", "numpy"}
+
+        Returns
+        -------
+        vertices : (V, 3) float32 (or ``out``)
+        """
+        kernels = self._kernels(backend)
+        dq, scale, has_scale = palette_dual_quaternions(palette)
+        res = self._output(out)
+        if kernels is not None and res.dtype == np.float32 and res.flags.c_contiguous:
+            self._dq[:] = dq
+            self._scale[:] = scale.reshape(-1, 9)
+            kernels.run("dqs", len(res), self.threads, self._rest32, self._indices32,
+                        self._weights32, self._dq, self._scale, has_scale, res)
+            return res
+        res[:] = dqs_skin(self.rest_vertices, self.indices, self.weights, dq,
+                          scale if has_scale else None)
         return res
 
 

@@ -1,0 +1,120 @@
+"""Skinning alone, every path, against the memory-copy floor, in one run.
+
+For 10k, 100k and 1M vertices, 40 joints, 4 influences per vertex (random weights, random rigid
+palettes) it prints the median time of one frame (palette -> skinned vertices, float32) of:
+
+- LBS, the compiled numba kernel on 1 thread and on 2 threads;
+- LBS, the numpy path (sparse (V x J) weights times the (J x 12) palette, then apply);
+- LBS, a dense reference (a dense float32 (V x J) weight matrix times the palette, einsum);
+- DQS, the compiled kernel on 1 and 2 threads, and the numpy reference;
+- the floor: the bytes a frame must move (read the float32 rest vertices, the int32 indices
+  and float32 weights, write the float32 output: 56 bytes per vertex) at the memory-copy
+  bandwidth measured in the same run (``np.copyto`` of 256 MB, read + write).
+
+Run: ``.venv/bin/python benchmarks/bench_skinning.py [--repeat-scale S]`` (BLAS pinned to one
+thread). The kernels are compiled (or loaded from numba's cache) before timing.
+"""
+from __future__ import annotations
+
+import os
+
+os.environ["OMP_NUM_THREADS"] = os.environ["OPENBLAS_NUM_THREADS"] = "1"
+
+import argparse
+import platform
+import time
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+from threadpoolctl import threadpool_limits
+
+from rigedit.model import SkinBinding, skinning_kernels
+from rigedit.model.skinning import top_k_influences
+
+J, K = 40, 4
+BYTES_PER_VERTEX = 12 + 4 * K + 4 * K + 12  # rest, indices, weights, output
+
+
+def median_ms(fn, repeat):
+    fn()
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return 1e3 * float(np.median(times))
+
+
+def bandwidth_gbs(nbytes=256_000_000, repeat=7):
+    a = np.ones(nbytes // 8)
+    b = np.empty_like(a)
+    ms = median_ms(lambda: np.copyto(b, a), repeat)
+    return 2 * nbytes / (ms * 1e-3) / 1e9  # read + write
+
+
+def random_palettes(rng, n):
+    pals = np.tile(np.eye(4), (n, J, 1, 1))
+    for i in range(n):
+        pals[i, :, :3, :3] = Rotation.random(J, random_state=int(rng.integers(1 << 30))).as_matrix()
+        pals[i, :, :3, 3] = rng.normal(size=(J, 3))
+    return pals
+
+
+def main(repeat_scale=1.0):
+    kernels = skinning_kernels.load()
+    if kernels is None:
+        raise SystemExit(f"compiled kernels unavailable: {skinning_kernels.error()}")
+    rng = np.random.default_rng(0)
+    pals = random_palettes(rng, 8)
+    bw = bandwidth_gbs()
+    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cpus, "
+          f"numpy {np.__version__}, numba {kernels.numba.__version__}, one BLAS thread")
+    print(f"memory-copy bandwidth: {bw:.1f} GB/s (np.copyto of 256 MB, read + write); floor = "
+          f"{BYTES_PER_VERTEX} bytes/vertex at that rate")
+    cols = ["floor", "LBS 1t", "LBS 2t", "LBS numpy", "dense ref", "DQS 1t", "DQS 2t",
+            "DQS numpy", "LBS1/floor", "DQS1/LBS1"]
+    print(f"{'vertices':>9} | " + " | ".join(f"{c:>10}" for c in cols) + "   (ms per frame)")
+    for v in (10_000, 100_000, 1_000_000):
+        rest = rng.normal(size=(v, 3))
+        idx, w = top_k_influences(rng.random((v, J)) ** 8, K)
+        binding = SkinBinding(rest, idx, w, J)
+        dense = binding.dense().astype(np.float32)
+        rest_h = np.c_[rest, np.ones(v)].astype(np.float32)
+        state = {"i": 0}
+
+        def palette():
+            state["i"] += 1
+            return pals[state["i"] % len(pals)]
+
+        def dense_frame():
+            p = palette()[:, :3, :].reshape(J, 12).astype(np.float32)
+            return np.einsum("vij,vj->vi", (dense @ p).reshape(v, 3, 4), rest_h)
+
+        p0 = pals[0]
+        ref = binding.skin(p0, backend="numpy").copy()
+        assert np.allclose(binding.skin(p0, backend="numba"), ref, atol=1e-4)
+        ref_dqs = binding.skin(p0, method="dqs", backend="numpy").copy()
+        assert np.allclose(binding.skin(p0, method="dqs", backend="numba"), ref_dqs, atol=1e-4)
+        repeat = max(3, int(repeat_scale * (200 if v <= 10_000 else 60 if v <= 100_000 else 15)))
+        row = {"floor": v * BYTES_PER_VERTEX / (bw * 1e9) * 1e3}
+        for threads in (1, 2):
+            binding.threads = threads
+            row[f"LBS {threads}t"] = median_ms(lambda: binding.skin(palette(), backend="numba"),
+                                              repeat)
+            row[f"DQS {threads}t"] = median_ms(
+                lambda: binding.skin(palette(), method="dqs", backend="numba"), repeat)
+        row["LBS numpy"] = median_ms(lambda: binding.skin(palette(), backend="numpy"), repeat)
+        row["dense ref"] = median_ms(dense_frame, max(3, repeat // 4))
+        row["DQS numpy"] = median_ms(
+            lambda: binding.skin(palette(), method="dqs", backend="numpy"), max(3, repeat // 4))
+        row["LBS1/floor"] = row["LBS 1t"] / row["floor"]
+        row["DQS1/LBS1"] = row["DQS 1t"] / row["LBS 1t"]
+        print(f"{v:>9,} | " + " | ".join(f"{row[c]:>10.3f}" for c in cols), flush=True)
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat-scale", type=float, default=1.0,
+                        help="multiply the number of timed frames per size")
+    with threadpool_limits(1):
+        main(parser.parse_args().repeat_scale)

@@ -1,0 +1,106 @@
+"""Dual-quaternion skinning (Kavan, Collins, Zara and O'Sullivan 2008), the numpy reference.
+
+Linear blend skinning averages matrices, so two joints twisted far apart average to a matrix
+that shrinks the skin between them (the "candy wrapper"); blending the joints' rigid motions as
+unit dual quaternions keeps it rigid. What is supported:
+
+- rigid joint motion (rotation and translation): blended as dual quaternions, each influence's
+  quaternion flipped into the hemisphere of the vertex's strongest influence, so a vertex
+  always takes the shortest way between its joints;
+- scale and shear, as Kavan et al. propose (section 4.2, "two-phase" skinning): each skinning
+  matrix's linear part ``A_j`` is split by polar decomposition into ``A_j = Q_j S_j`` (``Q_j`` a
+  rotation, ``S_j`` symmetric: the scale/shear in bind space); the ``S_j`` are blended linearly
+  and applied to the rest point first, then the rigid parts ``(Q_j, t_j)`` as dual
+  quaternions. A mirroring matrix (negative determinant) keeps its reflection in ``S_j``.
+  Without scale the first phase is skipped. A vertex with a single influence therefore moves
+  exactly as with linear blend skinning, scaled or not.
+
+The compiled kernel is :func:`rigedit.model.skinning_kernels._dqs_py`; this module's
+:func:`dqs_skin` is its reference and fallback.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+__all__ = ["palette_dual_quaternions", "dqs_skin"]
+
+
+def palette_dual_quaternions(palette, tol=1e-6):
+    """Split skinning matrices into unit dual quaternions and scale/shear matrices.
+
+    Parameters
+    ----------
+    palette : (J, 4, 4) float
+        Skinning matrices ``K_j = M_j · inverse_bind_j`` (affine).
+    tol : float
+        Largest deviation of every ``S_j`` from the identity still treated as no scale.
+
+    Returns
+    -------
+    dq : (J, 8) float64
+        Real part (x, y, z, w) then dual part (x, y, z, w) of each joint's rigid motion
+        ``(Q_j, t_j)``: the dual part is ``0.5 · (t_j, 0) ⊗ q_j``.
+    scale : (J, 3, 3) float64
+        ``S_j`` with ``A_j = Q_j · S_j``.
+    has_scale : bool
+        False when every ``S_j`` is the identity within ``tol``.
+    """
+    palette = np.asarray(palette, dtype=np.float64)
+    a = palette[:, :3, :3]
+    t = palette[:, :3, 3]
+    u, s, vt = np.linalg.svd(a)
+    # Polar decomposition from the SVD: Q = U Vt, S = V diag(s) Vt. A reflection (det < 0)
+    # flips the least-stretched axis in both factors, so Q stays a rotation.
+    d = np.ones_like(s)
+    d[np.linalg.det(u @ vt) < 0, 2] = -1.0
+    q_mat = (u * d[:, None, :]) @ vt
+    scale = np.einsum("jki,jk,jkl->jil", vt, s * d, vt)
+    qr = Rotation.from_matrix(q_mat).as_quat()
+    # dual part: 0.5 * (t, 0) ⊗ (r, w) = 0.5 * (w t + t × r, -t · r)
+    qd = np.empty_like(qr)
+    qd[:, :3] = 0.5 * (qr[:, 3:4] * t + np.cross(t, qr[:, :3]))
+    qd[:, 3] = -0.5 * np.einsum("ji,ji->j", t, qr[:, :3])
+    has_scale = bool(np.abs(scale - np.eye(3)).max(initial=0.0) > tol)
+    return np.concatenate([qr, qd], axis=1), scale, has_scale
+
+
+def dqs_skin(rest, indices, weights, dq, scale=None):
+    """Dual-quaternion skinning of every vertex (numpy reference).
+
+    Parameters
+    ----------
+    rest : (V, 3) float
+        Rest (bind-pose) vertex positions.
+    indices : (V, K) int
+        Joint index of each influence.
+    weights : (V, K) float
+        Influence weights, rows summing to 1.
+    dq : (J, 8) float
+        Unit dual quaternions from :func:`palette_dual_quaternions`.
+    scale : (J, 3, 3) float, optional
+        Scale/shear matrices, blended linearly and applied to the rest point first; None for
+        rigid motion only.
+
+    Returns
+    -------
+    vertices : (V, 3) float64
+    """
+    rest = np.asarray(rest, dtype=np.float64)
+    weights = np.asarray(weights, dtype=np.float64)
+    indices = np.asarray(indices)
+    q = np.asarray(dq, dtype=np.float64)[indices]  # (V, K, 8)
+    p = rest
+    if scale is not None:
+        blended = np.einsum("vk,vkij->vij", weights, np.asarray(scale, np.float64)[indices])
+        p = np.einsum("vij,vj->vi", blended, rest)
+    # Antipodality: q and -q are the same rotation; flip every influence into the hemisphere
+    # of the strongest one so the blend takes the short way.
+    pivot = q[np.arange(len(q)), np.argmax(weights, axis=1), :4]
+    sign = np.where(np.einsum("vki,vi->vk", q[:, :, :4], pivot) < 0.0, -1.0, 1.0)
+    b = np.einsum("vk,vki->vi", weights * sign, q)
+    b /= np.linalg.norm(b[:, :4], axis=1, keepdims=True)
+    r, w, d, e = b[:, :3], b[:, 3:4], b[:, 4:7], b[:, 7:8]
+    # p' = p + 2 r × (r × p + w p) + 2 (w d − e r + r × d)
+    return (p + 2.0 * np.cross(r, np.cross(r, p) + w * p)
+            + 2.0 * (w * d - e * r + np.cross(r, d)))

@@ -1,0 +1,267 @@
+"""Compiled skinning kernels (numba): linear blend and dual-quaternion skinning in one pass over
+the vertices, parallel over vertex ranges, into reused float32 buffers.
+
+The numpy code in :mod:`rigedit.model.skinning` and :mod:`rigedit.model.dqs` is the reference
+(the tests compare the two) and the fallback: these kernels are used only once they are
+compiled. Importing numba takes about half a second and compiling these kernels several
+seconds, neither of which may show in the editor, so:
+
+- nothing here imports numba at module import; :func:`start_loading` (called when a
+  :class:`~rigedit.model.skinning.SkinBinding` is made) imports and compiles in a background
+  thread, and until that is done :func:`ready` returns None and skinning runs in numpy;
+- the compiled code is cached on disk (numba's ``cache=True``): in ``__pycache__`` beside this
+  file when that folder is writable (a checkout, a user install), otherwise numba's per-user
+  cache folder (``~/.cache/numba``, or ``$NUMBA_CACHE_DIR``), so only the very first run on a
+  machine compiles; later ones load in a fraction of a second;
+- the kernels are compiled for exact signatures (C-contiguous float32 arrays, int32 indices):
+  a call with other types raises instead of compiling in the middle of a drag.
+
+``RIGEDIT_NO_NUMBA=1`` in the environment disables the kernels (numpy only).
+"""
+from __future__ import annotations
+
+import os
+import threading
+
+import numpy as np
+
+__all__ = ["ready", "load", "start_loading", "disabled", "error", "Kernels", "DISABLE_ENV",
+           "PARALLEL_MIN_VERTICES"]
+
+DISABLE_ENV = "RIGEDIT_NO_NUMBA"
+# Reassociation and FMA contraction let LLVM vectorise the blends; no "fast" flags that
+# assume finite values or approximate divisions and square roots.
+FASTMATH = {"contract", "reassoc", "nsz", "arcp"}
+
+prange = range  # replaced by numba.prange before compiling (numba reads module globals)
+
+
+def _lbs_py(rest, indices, weights, palette, out):
+    """LBS of every vertex: blend the K influences' 3x4 matrices, apply to the rest point.
+
+    rest (V, 3) f32, indices (V, K) i32, weights (V, K) f32, palette (J, 12) f32 (the top three
+    rows of each skinning matrix, row-major), out (V, 3) f32.
+    """
+    n, k_max = indices.shape
+    for v in prange(n):
+        m0 = m1 = m2 = m3 = m4 = m5 = m6 = m7 = m8 = m9 = m10 = m11 = np.float32(0.0)
+        for k in range(k_max):
+            w = weights[v, k]
+            p = palette[indices[v, k]]
+            m0 += w * p[0]
+            m1 += w * p[1]
+            m2 += w * p[2]
+            m3 += w * p[3]
+            m4 += w * p[4]
+            m5 += w * p[5]
+            m6 += w * p[6]
+            m7 += w * p[7]
+            m8 += w * p[8]
+            m9 += w * p[9]
+            m10 += w * p[10]
+            m11 += w * p[11]
+        x = rest[v, 0]
+        y = rest[v, 1]
+        z = rest[v, 2]
+        out[v, 0] = m0 * x + m1 * y + m2 * z + m3
+        out[v, 1] = m4 * x + m5 * y + m6 * z + m7
+        out[v, 2] = m8 * x + m9 * y + m10 * z + m11
+
+
+def _lbs_normals_py(rest, rest_normals, indices, weights, palette, out, out_normals):
+    """:func:`_lbs_py` plus the normals: the blended 3x3 applied to the rest normal, then
+    renormalised (exact for rotations and uniform scale; the usual approximation otherwise)."""
+    n, k_max = indices.shape
+    for v in prange(n):
+        m0 = m1 = m2 = m3 = m4 = m5 = m6 = m7 = m8 = m9 = m10 = m11 = np.float32(0.0)
+        for k in range(k_max):
+            w = weights[v, k]
+            p = palette[indices[v, k]]
+            m0 += w * p[0]
+            m1 += w * p[1]
+            m2 += w * p[2]
+            m3 += w * p[3]
+            m4 += w * p[4]
+            m5 += w * p[5]
+            m6 += w * p[6]
+            m7 += w * p[7]
+            m8 += w * p[8]
+            m9 += w * p[9]
+            m10 += w * p[10]
+            m11 += w * p[11]
+        x = rest[v, 0]
+        y = rest[v, 1]
+        z = rest[v, 2]
+        out[v, 0] = m0 * x + m1 * y + m2 * z + m3
+        out[v, 1] = m4 * x + m5 * y + m6 * z + m7
+        out[v, 2] = m8 * x + m9 * y + m10 * z + m11
+        nx = rest_normals[v, 0]
+        ny = rest_normals[v, 1]
+        nz = rest_normals[v, 2]
+        a = m0 * nx + m1 * ny + m2 * nz
+        b = m4 * nx + m5 * ny + m6 * nz
+        c = m8 * nx + m9 * ny + m10 * nz
+        length = np.sqrt(a * a + b * b + c * c)
+        inv = np.float32(1.0) / length if length > np.float32(0.0) else np.float32(0.0)
+        out_normals[v, 0] = a * inv
+        out_normals[v, 1] = b * inv
+        out_normals[v, 2] = c * inv
+
+
+def _dqs_py(rest, indices, weights, dq, scale, has_scale, out):
+    """Dual-quaternion skinning of every vertex (Kavan et al. 2008).
+
+    dq (J, 8) f32: each joint's rigid part as a unit dual quaternion, real (x, y, z, w) then
+    dual (x, y, z, w); scale (J, 9) f32: each joint's scale/shear part (row-major 3x3),
+    blended linearly and applied to the rest point first when ``has_scale``. Each influence's
+    quaternion is flipped into the hemisphere of the vertex's strongest influence.
+    """
+    n, k_max = indices.shape
+    for v in prange(n):
+        # the strongest influence: its rotation fixes the hemisphere of the blend
+        kp = 0
+        for k in range(1, k_max):
+            if weights[v, k] > weights[v, kp]:
+                kp = k
+        pivot = dq[indices[v, kp]]
+        x = rest[v, 0]
+        y = rest[v, 1]
+        z = rest[v, 2]
+        if has_scale:
+            s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = s8 = np.float32(0.0)
+            for k in range(k_max):
+                w = weights[v, k]
+                s = scale[indices[v, k]]
+                s0 += w * s[0]
+                s1 += w * s[1]
+                s2 += w * s[2]
+                s3 += w * s[3]
+                s4 += w * s[4]
+                s5 += w * s[5]
+                s6 += w * s[6]
+                s7 += w * s[7]
+                s8 += w * s[8]
+            x, y, z = (s0 * x + s1 * y + s2 * z, s3 * x + s4 * y + s5 * z,
+                       s6 * x + s7 * y + s8 * z)
+        b0 = b1 = b2 = b3 = e0 = e1 = e2 = e3 = np.float32(0.0)
+        for k in range(k_max):
+            q = dq[indices[v, k]]
+            w = weights[v, k]
+            if q[0] * pivot[0] + q[1] * pivot[1] + q[2] * pivot[2] + q[3] * pivot[3] < np.float32(0.0):
+                w = -w
+            b0 += w * q[0]
+            b1 += w * q[1]
+            b2 += w * q[2]
+            b3 += w * q[3]
+            e0 += w * q[4]
+            e1 += w * q[5]
+            e2 += w * q[6]
+            e3 += w * q[7]
+        inv = np.float32(1.0) / np.sqrt(b0 * b0 + b1 * b1 + b2 * b2 + b3 * b3)
+        b0 *= inv
+        b1 *= inv
+        b2 *= inv
+        b3 *= inv
+        e0 *= inv
+        e1 *= inv
+        e2 *= inv
+        e3 *= inv
+        # p' = p + 2 r x (r x p + w p) + 2 (w d - e_w r + r x d), r = (b0, b1, b2), w = b3
+        cx = b1 * z - b2 * y + b3 * x
+        cy = b2 * x - b0 * z + b3 * y
+        cz = b0 * y - b1 * x + b3 * z
+        tx = b3 * e0 - e3 * b0 + b1 * e2 - b2 * e1
+        ty = b3 * e1 - e3 * b1 + b2 * e0 - b0 * e2
+        tz = b3 * e2 - e3 * b2 + b0 * e1 - b1 * e0
+        two = np.float32(2.0)
+        out[v, 0] = x + two * (b1 * cz - b2 * cy + tx)
+        out[v, 1] = y + two * (b2 * cx - b0 * cz + ty)
+        out[v, 2] = z + two * (b0 * cy - b1 * cx + tz)
+
+
+#: Below this many vertices a frame runs on one thread: waking a second one costs more than it
+#: saves there, and on a busy machine a parallel call waits for its slowest thread.
+PARALLEL_MIN_VERTICES = 100_000
+
+
+class Kernels:
+    """The compiled kernels (attributes ``lbs``, ``lbs_normals``, ``dqs``) and numba itself.
+
+    Call them through :meth:`run`, which picks the number of threads and serialises calls:
+    numba's default "workqueue" threading layer must not run two parallel kernels at once.
+    """
+
+    def __init__(self, numba):
+        global prange
+        prange = numba.prange
+        self.max_threads = numba.config.NUMBA_NUM_THREADS
+        self._call_lock = threading.Lock()
+        f32 = numba.float32[:, ::1]
+        i32 = numba.int32[:, ::1]
+        opts = {"parallel": True, "fastmath": FASTMATH, "cache": True, "nogil": True}
+        self.numba = numba
+        self.lbs = numba.njit([numba.void(f32, i32, f32, f32, f32)], **opts)(_lbs_py)
+        self.lbs_normals = numba.njit([numba.void(f32, f32, i32, f32, f32, f32, f32)],
+                                      **opts)(_lbs_normals_py)
+        self.dqs = numba.njit([numba.void(f32, i32, f32, f32, f32, numba.boolean, f32)],
+                              **opts)(_dqs_py)
+
+    def run(self, name, n_vertices, threads, *args):
+        """Run kernel ``name`` on ``args`` with ``threads`` threads (None: one below
+        ``PARALLEL_MIN_VERTICES`` vertices, all of numba's above)."""
+        if threads is None:
+            threads = 1 if n_vertices < PARALLEL_MIN_VERTICES else self.max_threads
+        with self._call_lock:
+            self.numba.set_num_threads(max(1, min(int(threads), self.max_threads)))
+            getattr(self, name)(*args)
+
+
+_lock = threading.Lock()
+_state = {"kernels": None, "tried": False, "error": None, "thread": None}
+
+
+def disabled():
+    """True when ``RIGEDIT_NO_NUMBA`` asks for the numpy path only."""
+    return os.environ.get(DISABLE_ENV, "").strip() not in ("", "0")
+
+
+def ready():
+    """The compiled :class:`Kernels` if they are loaded, else None (never waits)."""
+    return _state["kernels"]
+
+
+def load():
+    """The compiled :class:`Kernels`, importing numba and compiling (or loading the cached
+    code) on the first call; None when numba is missing, disabled or fails to compile (the
+    reason is in ``error()``). Blocks while another thread is loading."""
+    if _state["tried"]:
+        return _state["kernels"]
+    with _lock:
+        if not _state["tried"]:
+            if disabled():
+                _state["error"] = f"disabled by {DISABLE_ENV}"
+            else:
+                try:
+                    import numba
+
+                    _state["kernels"] = Kernels(numba)
+                except Exception as exc:  # numba missing, or LLVM cannot compile here
+                    _state["error"] = f"{type(exc).__name__}: {exc}"
+            _state["tried"] = True
+    return _state["kernels"]
+
+
+def error():
+    """Why the kernels are not available (None when they are, or were not tried yet)."""
+    return _state["error"]
+
+
+def start_loading():
+    """Load the kernels in a background daemon thread (once per process); returns at once."""
+    if _state["tried"] or _state["thread"] is not None or disabled():
+        return
+    with _lock:
+        if _state["thread"] is None:
+            _state["thread"] = threading.Thread(target=load, name="rigedit-kernels",
+                                                daemon=True)
+            _state["thread"].start()

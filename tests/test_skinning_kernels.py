@@ -1,0 +1,83 @@
+"""The compiled skinning kernels agree with the numpy reference, and the numpy path takes over
+when the kernels are disabled."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from rigedit.model import SkinBinding, skinning_kernels
+from rigedit.model.skinning import top_k_influences
+
+pytestmark = pytest.mark.skipif(bool(os.environ.get(skinning_kernels.DISABLE_ENV)),
+                                reason="compiled kernels disabled by RIGEDIT_NO_NUMBA")
+
+
+def random_binding(v, j, k, seed):
+    rng = np.random.default_rng(seed)
+    idx, w = top_k_influences(rng.random((v, j)) ** 6, k)
+    return SkinBinding(rng.normal(size=(v, 3)) * 2.0, idx, w, j)
+
+
+def random_palette(j, seed, scale=True):
+    rng = np.random.default_rng(seed)
+    pal = np.tile(np.eye(4), (j, 1, 1))
+    pal[:, :3, :3] = Rotation.random(j, random_state=seed).as_matrix()
+    if scale:
+        pal[:, :3, :3] = pal[:, :3, :3] @ (np.eye(3) * rng.uniform(0.5, 1.5, (j, 1, 3))
+                                           + 0.1 * rng.normal(size=(j, 3, 3)))
+    pal[:, :3, 3] = rng.normal(size=(j, 3))
+    return pal
+
+
+def test_kernels_load():
+    assert skinning_kernels.load() is not None, skinning_kernels.error()
+
+
+@pytest.mark.parametrize("k", [1, 4, 8])
+@pytest.mark.parametrize("method", ["lbs", "dqs"])
+@pytest.mark.parametrize("scale", [False, True])
+def test_compiled_and_numpy_paths_agree_to_float32_precision(k, method, scale):
+    binding = random_binding(4000, 30, k, seed=k)
+    for trial in range(3):
+        pal = random_palette(30, seed=10 * k + trial, scale=scale)
+        ref = binding.skin(pal, method=method, backend="numpy").copy()
+        got = binding.skin(pal, method=method, backend="numba").copy()
+        assert got.dtype == np.float32
+        # float32 blends of a few terms of size ~5: a few units in the last place
+        assert np.abs(got - ref).max() <= 4e-6 * max(1.0, np.abs(ref).max())
+
+
+def test_compiled_path_rejects_other_types_instead_of_compiling():
+    binding = random_binding(100, 5, 4, seed=1)
+    kernels = skinning_kernels.load()
+    with pytest.raises(TypeError):
+        kernels.lbs(binding._rest32.astype(np.float64), binding._indices32, binding._weights32,
+                    binding._palette, np.empty((100, 3), np.float32))
+
+
+def test_out_of_another_dtype_goes_through_numpy():
+    binding = random_binding(500, 8, 4, seed=2)
+    pal = random_palette(8, seed=3)
+    out64 = np.empty((500, 3))
+    binding.skin(pal, out=out64, backend="numba")
+    assert np.allclose(out64, binding.skin(pal, backend="numpy"), atol=1e-5)
+
+
+def test_no_numba_environment_variable_forces_the_numpy_path():
+    code = ("import sys, numpy as np\n"
+            "from rigedit.model import SkinBinding, skinning_kernels as k\n"
+            "b = SkinBinding(np.eye(3), [[0], [1], [1]], [[1.0], [1.0], [1.0]], 2)\n"
+            "p = np.tile(np.eye(4), (2, 1, 1)); p[1, :3, 3] = [1, 2, 3]\n"
+            "out = b.skin(p, method='dqs')\n"
+            "print(k.load() is None, 'numba' in sys.modules, k.error())\n"
+            "print(out.tolist())\n")
+    env = dict(os.environ, RIGEDIT_NO_NUMBA="1")
+    proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    first, second = proc.stdout.strip().splitlines()
+    assert first == "True False disabled by RIGEDIT_NO_NUMBA"
+    assert np.allclose(eval(second), [[1, 0, 0], [1, 3, 3], [1, 2, 4]])
