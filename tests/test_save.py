@@ -103,17 +103,42 @@ def test_clip_keeps_its_file_name_and_a_foreign_clip_file_is_left_alone(tmp_path
     assert sorted(load(folder).clips) == ["bend", "extra"]
 
 
-def test_a_foreign_file_holding_a_clip_being_saved_stops_the_save(tmp_path):
+def test_an_unrecorded_file_of_a_saved_clip_is_its_file_a_second_one_stops_the_save(tmp_path):
     folder = tmp_path / "r"
     rig = cylinder_rig()
     save_rig_folder(folder, rig)
-    before = (folder / "animations" / "bend.json").read_bytes()
+    # a file rigedit has no record of, holding a clip the rig has too (a recovered document,
+    # or one saved over a folder it did not come from): it becomes that clip's file
     save_clip(folder / "animations" / "other.json", rig.clips["bend"].copy("wave"))
     rig.clips["wave"] = rig.clips["bend"].copy("wave")
-    with pytest.raises(RigFileError, match="other.json.*'wave'"):
+    rig.clips["wave"].loop = False
+    files = save_rig_folder(folder, rig)
+    assert files == {"bend": "animations/bend.json", "wave": "animations/other.json"}
+    assert load(folder).clips["wave"].loop is False
+    # a second file holding 'bend', which has its own file: an error naming both, nothing
+    # written
+    before = listing(folder), (folder / "animations" / "bend.json").read_bytes()
+    save_clip(folder / "animations" / "copy.json", rig.clips["bend"])
+    rig.clips["bend"].loop = False
+    with pytest.raises(RigFileError, match=r"copy\.json: .*'bend'.*bend\.json"):
         save_rig_folder(folder, rig)
-    assert (folder / "animations" / "bend.json").read_bytes() == before
-    assert not (folder / STAGING).exists()
+    assert (listing(folder), (folder / "animations" / "bend.json").read_bytes()) == (
+        sorted(before[0] + ["animations/copy.json"]), before[1])
+
+
+def test_a_rig_without_a_record_saved_over_an_elk_folder_replaces_its_clip(tmp_path):
+    """A document recovered after a crash has no record of the files it came from; saving
+    it over its folder writes its clip into the file that holds that clip."""
+    folder = write_elk_folder(tmp_path / "elk")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rig = load_rig_folder(folder)
+        save_rig_folder(tmp_path / "snapshot", rig)
+        recovered = load_rig_folder(tmp_path / "snapshot")
+    recovered.clips["bow"].loop = False
+    save_rig_folder(folder, recovered)
+    assert sorted(os.listdir(folder / "animations")) == ["bow.json"]
+    assert load(folder).clips["bow"].loop is False
 
 
 def test_two_files_declaring_one_clip_name_name_both(tmp_path):

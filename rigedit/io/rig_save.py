@@ -27,12 +27,15 @@ A save deletes from ``animations/`` only clip files that are rigedit's:
 - those the saved rig's clips were read from, when they are in this folder
   (``load_rig_folder`` records them with :func:`remember_clip_files`).
 
+- a clip file it has no record of that holds a clip of a name being saved becomes that clip's
+  file (a document recovered after a crash, or saved over a folder it did not come from).
+
 A clip that is deleted or renamed in the editor is therefore gone after the save. Every other
-file is left as it is: a README, pictures, a clip file someone copied in after the rig was
-loaded (it loads as one more clip next time). A file rigedit did not write that holds a clip of
-the same name as one being saved is an error (the folder would not load), named in the
-message, before anything is written. The rig's own files (``rig.json``, the mesh,
-``skeleton.json``, ``weights.npz``) are replaced.
+file is left as it is: a README, pictures, a clip file of another name someone copied in after
+the rig was loaded (it loads as one more clip next time). A second file holding a clip of a
+name being saved is an error (the folder would not load), named in the message, before
+anything is written. The rig's own files (``rig.json``, the mesh, ``skeleton.json``,
+``weights.npz``) are replaced.
 """
 from __future__ import annotations
 
@@ -117,9 +120,11 @@ def _declared_name(path):
 def plan_clip_files(folder, rig, names):
     """File names for the clips being saved, and the stale clip files to delete.
 
-    A clip keeps the file it was loaded from or last saved to (``rig.json``'s record); a new
-    or renamed clip gets one derived from its name (:func:`clip_file_stem`), never one that a
-    file rigedit did not write already has.
+    A clip keeps the file it was loaded from or last saved to (``rig.json``'s record). A clip
+    file rigedit has no record of that holds a clip of a name being saved is that clip's file
+    (a recovered or re-opened document saved over its folder) unless the clip already has
+    one. A new or renamed clip gets a file name derived from its name
+    (:func:`clip_file_stem`), never one that another file already has.
 
     Returns
     -------
@@ -127,6 +132,12 @@ def plan_clip_files(folder, rig, names):
         Clip name -> file name inside ``animations/``.
     stale : list[str]
         File names inside ``animations/`` to delete.
+
+    Raises
+    ------
+    RigFileError
+        A file rigedit has no record of holds a clip of a name being saved that has its own
+        file already: the folder would hold that name twice.
     """
     anim = (folder / ANIMATIONS).resolve()
     previous = {}   # clip name -> file name in animations/, for rigedit's files
@@ -138,10 +149,22 @@ def plan_clip_files(folder, rig, names):
     for name, path in _LOADED_FROM.get(rig, {}).items():
         if path.parent == anim:
             previous[name] = path.name
-    ours = {name_key(f) for f in previous.values()}
     present = sorted(p.name for p in anim.iterdir()) if anim.is_dir() else []
-    foreign = [f for f in present if name_key(f) not in ours]
-    used = {name_key(f) for f in foreign}
+    on_disk = {name_key(f) for f in present}
+    ours = {name_key(f) for f in previous.values()}
+    for file in present:
+        if name_key(file) in ours or not file.endswith(".json"):
+            continue
+        declared = _declared_name(anim / file)
+        if declared not in names:
+            continue
+        if declared in previous and name_key(previous[declared]) in on_disk:
+            raise RigFileError(anim / file, f"holds a clip {declared!r}, and so does "
+                               f"{previous[declared]}, which this save writes: expected one "
+                               "file per clip name (move the file away or rename the clip)")
+        previous[declared] = file
+        ours.add(name_key(file))
+    used = {name_key(f) for f in present if name_key(f) not in ours}
     files = {}
     for name in names:   # first the clips that keep their file
         file = previous.get(name)
@@ -152,14 +175,6 @@ def plan_clip_files(folder, rig, names):
         if name not in files:
             files[name] = clip_file_stem(name, used) + ".json"
             used.add(name_key(files[name]))
-    wanted = {name_key(n) for n in names}
-    for file in foreign:
-        if file.endswith(".json"):
-            declared = _declared_name(anim / file)
-            if declared is not None and name_key(declared) in wanted:
-                raise RigFileError(anim / file, f"holds a clip {declared!r}, and this save "
-                                   "writes a clip of that name: expected no other file with "
-                                   "it (move the file away or rename the clip)")
     kept = {name_key(f) for f in files.values()}
     stale = sorted(f for f in present if name_key(f) in ours and name_key(f) not in kept
                    and f.endswith(".json"))
