@@ -344,3 +344,21 @@ def test_missing_parent_folder_is_an_error_naming_the_folder(tmp_path):
     with pytest.raises(RigFileError, match=str(target)):
         save_rig_folder(target, cylinder_rig())
     assert not (tmp_path / "no").exists()
+
+
+def test_a_recovered_rig_given_the_original_record_deletes_a_deleted_clip(tmp_path):
+    from rigedit.io.rig_save import loaded_clip_files, remember_clip_files
+
+    folder = write_elk_folder(tmp_path / "elk")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rig = load_rig_folder(folder)
+        rig.clips.clear()                      # deleted in the editor, then a crash
+        save_rig_folder(tmp_path / "snapshot", rig)
+        recovered = load_rig_folder(tmp_path / "snapshot")
+    assert loaded_clip_files(rig) == {"bow": (folder / "animations" / "bow.json").resolve()}
+    save_rig_folder(folder, recovered)         # no record: the unknown file stays
+    assert (folder / "animations" / "bow.json").exists()
+    remember_clip_files(recovered, loaded_clip_files(rig))
+    save_rig_folder(folder, recovered)
+    assert list(load(folder).clips) == []

@@ -55,7 +55,7 @@ from .skeleton_json import save_skeleton
 from .weights_npz import save_weights
 
 __all__ = ["save_rig_folder_atomic", "recover_interrupted_save", "remember_clip_files",
-           "is_bundled", "STAGING", "JOURNAL"]
+           "loaded_clip_files", "is_bundled", "STAGING", "JOURNAL"]
 
 #: The staging folder inside a rig folder, and the journal inside it.
 STAGING = ".rigedit-save"
@@ -68,8 +68,18 @@ _LOADED_FROM = weakref.WeakKeyDictionary()
 
 
 def remember_clip_files(rig, files):
-    """Record that ``rig``'s clips were read from ``files`` (``{clip name: path}``)."""
+    """Record that ``rig``'s clips were read from ``files`` (``{clip name: path}``).
+
+    ``load_rig_folder`` calls it; code that rebuilds a rig from a copy of it (a recovery
+    snapshot) can pass on :func:`loaded_clip_files` of the original, so that a save over the
+    original folder still deletes the files of clips deleted since."""
     _LOADED_FROM[rig] = {name: Path(p).resolve() for name, p in files.items()}
+
+
+def loaded_clip_files(rig):
+    """``{clip name: path}`` of the files ``rig``'s clips were read from (empty for a rig
+    built in code)."""
+    return dict(_LOADED_FROM.get(rig, {}))
 
 
 def is_bundled(path):
