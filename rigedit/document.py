@@ -243,6 +243,10 @@ class Document:
         self.selection = None
         self.current_clip = next(iter(rig.clips), None)
         self.time = 0.0
+        if len(rig.vertices) == 0 and self.current_clip is not None:
+            # a skeleton without a mesh (BVH) has an arbitrary rest pose (Bandai's lies flat):
+            # show its motion's first frame, where the timeline starts
+            rig.clips[self.current_clip].sample(0.0, out=self.pose)
         self.mirror = mirror_map(rig.skeleton.names)
 
     def set_rig(self, rig, modified=False):

@@ -41,6 +41,9 @@ class Rig:
         self.name = name
         self.up = up
         self.path = path
+        #: What a reader decided where its format was silent, shown by ``rigedit info``:
+        #: ``{"units": ..., "frames": ...}``
+        self.notes = {}
         self.surface = surface
         self.weights_computed = indices is None
         if indices is None:
@@ -82,8 +85,35 @@ class Rig:
         return out
 
     def bounds(self):
-        """(2, 3) min and max corner of the rest mesh."""
-        return np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)])
+        """(2, 3) min and max corner of the rest mesh; of the joints and bone tails at bind
+        time for a rig without a mesh (a BVH skeleton)."""
+        points = self.vertices
+        if len(points) == 0:
+            sk = self.skeleton
+            tails = sk.tails[np.all(np.isfinite(sk.tails), axis=1)]
+            points = np.vstack([sk.bind_matrices[:, :3, 3], tails])
+        return np.stack([points.min(axis=0), points.max(axis=0)])
+
+    def posed_tails(self, model):
+        """Bone tails (End Sites, leaf tails) carried by their joints' motion.
+
+        Parameters
+        ----------
+        model : (J, 4, 4) float64
+            Model matrices of a pose (:meth:`joint_matrices`).
+
+        Returns
+        -------
+        joints : (T,) int
+            The joints that have a tail.
+        tails : (T, 3) float64
+            Their tails in model space.
+        """
+        sk = self.skeleton
+        joints = np.flatnonzero(np.all(np.isfinite(sk.tails), axis=1))
+        local = np.einsum("tij,tj->ti", sk.inverse_bind_matrices[joints],
+                          np.c_[sk.tails[joints], np.ones(len(joints))])
+        return joints, np.einsum("tij,tj->ti", model[joints], local)[:, :3]
 
     def height(self):
         """Extent along the up axis, a scale for sizes in views and tolerances."""

@@ -37,6 +37,7 @@ import numpy as np
 from ..animation.clip import Clip, Track
 from ..errors import RigFileError
 from ..model.skeleton import Skeleton
+from ..model.transforms import compose_trs
 from ..rig import Rig
 
 __all__ = ["load_bvh", "save_bvh", "parse_bvh", "guess_unit", "euler_channels_to_quats",
@@ -294,6 +295,20 @@ def _rest_points(parents, offsets, ends):
     return heads, np.array(tips).reshape(-1, 3)
 
 
+def _deforming(parents, heads, tips):
+    """(J,) bool: False for a root that only carries the figure (Bandai's ``joint_Root``): a
+    root with one child, at the figure's lowest level, so its "bone" would run from the floor
+    up to the hips."""
+    deform = np.ones(len(parents), dtype=bool)
+    points = np.vstack([heads, tips])
+    height = float(np.ptp(points[:, 1])) or 1.0
+    for r in np.flatnonzero(parents < 0):
+        if (np.sum(parents == r) == 1
+                and heads[r, 1] - points[:, 1].min() < 0.05 * height):
+            deform[r] = False
+    return deform
+
+
 def guess_unit(size):
     """The unit under which a figure ``size`` file units tall is nearest an adult's height.
 
@@ -372,6 +387,44 @@ def _euler_quats(frames, channels, col):
     return euler_channels_to_quats(frames[:, [c for _, c in rot]], [axis for axis, _ in rot])
 
 
+def _channel_values(data):
+    """Per-joint rotation quaternions (N, 4) and local translations (N, 3) in file units:
+    ``{joint index: array}`` for the joints that have such channels."""
+    frames, offsets = data["frames"], data["offsets"]
+    rotations, translations = {}, {}
+    col = 0
+    for j, channels in enumerate(data["channels"]):
+        kinds = [kind for kind, _ in channels]
+        if "rotation" in kinds:
+            rotations[j] = _euler_quats(frames, channels, col)
+        if "position" in kinds:
+            values = np.repeat(offsets[j][None], len(frames), axis=0)
+            for k, (kind, axis) in enumerate(channels):
+                if kind == "position":  # replaces the OFFSET component (module notes)
+                    values[:, axis] = frames[:, col + k]
+            translations[j] = values
+        col += len(channels)
+    return rotations, translations
+
+
+def _figure_size(data, rotations, translations):
+    """Largest extent of the figure (joints and End Sites, file units) at frame 0, or at
+    rest when the file has no frames: a standing figure's height (or arm span)."""
+    offsets, ends = data["offsets"], data["ends"]
+    sk = Skeleton(data["names"], data["parents"], offsets)
+    pose_t, pose_r = offsets.copy(), sk.rest_rotation.copy()
+    if len(data["frames"]):
+        for j, q in rotations.items():
+            pose_r[j] = q[0]
+        for j, t in translations.items():
+            pose_t[j] = t[0]
+    model = sk.forward(compose_trs(pose_t, pose_r))
+    points = [model[:, :3, 3]] + [model[j, :3, :3] @ e + model[j, :3, 3]
+                                  for j, e in enumerate(ends) if e is not None]
+    points = np.vstack(points)
+    return float(np.max(points.max(axis=0) - points.min(axis=0)))
+
+
 def load_bvh(path, scale=None):
     """Read a BVH file into a mesh-less :class:`Rig` with one clip (see the module notes).
 
@@ -379,7 +432,8 @@ def load_bvh(path, scale=None):
     ----------
     path : str or os.PathLike
     scale : float, optional
-        Metres per file unit; guessed from the figure's size when omitted (and reported).
+        Metres per file unit; guessed from the figure's size at the first frame when
+        omitted (and reported).
 
     Returns
     -------
@@ -390,44 +444,34 @@ def load_bvh(path, scale=None):
     path = Path(path)
     data = parse_bvh(path)
     offsets, parents, ends = data["offsets"], data["parents"], data["ends"]
-    heads, tips = _rest_points(parents, offsets, ends)
+    rotations, translations = _channel_values(data)
     if scale is None:
-        points = np.vstack([heads, tips])
-        size = float(np.max(points.max(axis=0) - points.min(axis=0)))
+        size = _figure_size(data, rotations, translations)
         unit, scale = guess_unit(size)
-        units_note = (f"guessed {unit} (figure {size:.4g} units tall at rest, "
-                      f"scale {scale:g} m per unit); pass --scale/scale= to override")
+        units_note = (f"guessed {unit} from the figure's size ({size:.4g} units at frame 0), "
+                      f"scale {scale:g} m per unit; pass --scale/scale= to override")
         warnings.warn(f"{path}: BVH has no units; {units_note}", BvhUnitsWarning, stacklevel=2)
     else:
         scale = float(scale)
         if not np.isfinite(scale) or scale <= 0:
             raise RigFileError(path, f"expected a scale > 0 (metres per unit), got {scale}")
         units_note = f"scale {scale:g} m per unit (given)"
+    heads, tips = _rest_points(parents, offsets, ends)
     tails = np.full_like(heads, np.nan)
     for j, end in enumerate(ends):
         if end is not None and np.any(end != 0):
             tails[j] = (heads[j] + end) * scale
     names = data["names"]
-    skeleton = Skeleton(names, parents, offsets * scale, tails=tails)
+    skeleton = Skeleton(names, parents, offsets * scale, tails=tails,
+                        deform=_deforming(parents, heads, tips))
     clips = {}
-    frames = data["frames"]
-    if len(frames):
-        times = np.arange(len(frames)) * data["frame_time"]
-        tracks = {}
-        col = 0
-        for j, channels in enumerate(data["channels"]):
-            kinds = [kind for kind, _ in channels]
-            if "rotation" in kinds:
-                tracks[(names[j], "rotation")] = Track(
-                    "rotation", times, _euler_quats(frames, channels, col), "slerp")
-            if "position" in kinds:
-                values = np.repeat(offsets[j][None], len(frames), axis=0)
-                for k, (kind, axis) in enumerate(channels):
-                    if kind == "position":  # replaces the OFFSET component (module notes)
-                        values[:, axis] = frames[:, col + k]
-                tracks[(names[j], "translation")] = Track("translation", times,
-                                                          values * scale, "linear")
-            col += len(channels)
+    if len(data["frames"]):
+        times = np.arange(len(data["frames"])) * data["frame_time"]
+        tracks = {(names[j], "rotation"): Track("rotation", times, q, "slerp")
+                  for j, q in rotations.items()}
+        tracks.update({(names[j], "translation"): Track("translation", times, t * scale,
+                                                        "linear")
+                       for j, t in translations.items()})
         clips[CLIP_NAME] = Clip(CLIP_NAME, skeleton, tracks, duration=float(times[-1]),
                                 loop=False)
     rig = Rig(skeleton, np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64),

@@ -18,7 +18,7 @@ import pyvista as pv
 
 from ..errors import RigFileError
 from ..io.atomic import check_output_folder, naming_target, temp_beside
-from .scene import RigScene, turn_about, up_vector
+from .scene import RigScene, joint_points, turn_about, up_vector
 
 __all__ = ["record_clip", "frame_times", "camera_state", "apply_camera", "VIDEO_SUFFIXES",
            "RecordingCancelled"]
@@ -245,7 +245,8 @@ def _horizontal(offset, up):
 
 def swept_points(rig, clip, times, samples=12, per_frame=3000):
     """Vertices the clip sweeps over the recorded times, with the root's horizontal motion
-    taken out (the camera follows it), to frame the whole motion.
+    taken out (the camera follows it), to frame the whole motion. A rig without a mesh is
+    framed by its joints (and bone tails) instead.
 
     Returns
     -------
@@ -253,15 +254,17 @@ def swept_points(rig, clip, times, samples=12, per_frame=3000):
     """
     step = max(1, len(rig.vertices) // per_frame)
     if clip is None:
-        return rig.vertices[::step]
+        return rig.vertices[::step] if len(rig.vertices) else rig.bounds()
     up = up_vector(rig.up)
     pose = rig.rest_pose()
     pts, root0 = [], None
     for t in np.linspace(times[0], times[-1], min(samples, len(times))):
         clip.sample(t, out=pose)
-        root = rig.joint_matrices(pose)[0, :3, 3]
+        model = rig.joint_matrices(pose)
+        root = model[0, :3, 3]
         root0 = root if root0 is None else root0
-        pts.append(rig.skin(pose)[::step] - _horizontal(root - root0, up))
+        shown = rig.skin(pose)[::step] if len(rig.vertices) else joint_points(rig, model)
+        pts.append(shown - _horizontal(root - root0, up))
     return np.concatenate(pts)
 
 

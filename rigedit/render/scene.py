@@ -13,7 +13,8 @@ from scipy.spatial.transform import Rotation
 
 from ..model.kinematics import skinning_matrices
 
-__all__ = ["RigScene", "up_vector", "front_vector", "faces_to_vtk", "turn_about"]
+__all__ = ["RigScene", "up_vector", "front_vector", "faces_to_vtk", "turn_about",
+           "joint_points"]
 
 MESH_COLOR = "#c9b79c"
 BONE_COLOR = "#2f6fd6"
@@ -45,6 +46,18 @@ def _nice_cell(size):
     return float((1 if base < 1.5 else 2 if base < 3.5 else 5) * 10 ** exp)
 
 
+def joint_points(rig, model):
+    """(J + T, 3) what a mesh-less rig shows of a pose: its joints and bone tails.
+
+    Parameters
+    ----------
+    rig : Rig
+    model : (J, 4, 4) float64
+        Model matrices of the pose.
+    """
+    return np.vstack([model[:, :3, 3], rig.posed_tails(model)[1]])
+
+
 def faces_to_vtk(faces):
     """(F, 3) triangles -> pyvista's flat ``[3, a, b, c, ...]`` cell array."""
     faces = np.asarray(faces, dtype=np.int64)
@@ -74,17 +87,24 @@ class RigScene:
         self.rig = rig
         self.up = up_vector(rig.up)
         self.front = front_vector(rig.up)
-        self.mesh = pv.PolyData(rig.vertices.astype(np.float32).copy(), faces_to_vtk(rig.faces))
-        # Normals recomputed by VTK inside the pipeline each time the points change: smooth
-        # shading stays right under deformation at a few ms per frame.
-        self._normals = vtk.vtkPolyDataNormals()
-        self._normals.SetInputData(self.mesh)
-        self._normals.SplittingOff()
-        self._normals.ConsistencyOff()
-        self._normals.AutoOrientNormalsOff()
-        self._normals.ComputeCellNormalsOff()
-        self.mesh_actor = plotter.add_mesh(self._normals, color=MESH_COLOR, smooth_shading=True,
-                                           specular=0.25, specular_power=20, name="rig-mesh")
+        #: False for a rig with no mesh (a BVH skeleton): no mesh actor, the skeleton drawn
+        #: bolder with its joints as balls so it reads on its own
+        self.has_mesh = len(rig.vertices) > 0
+        self.mesh = pv.PolyData(rig.vertices.astype(np.float32).copy(),
+                                faces_to_vtk(rig.faces) if len(rig.faces) else None)
+        self.mesh_actor = None
+        if self.has_mesh:
+            # Normals recomputed by VTK inside the pipeline each time the points change:
+            # smooth shading stays right under deformation at a few ms per frame.
+            self._normals = vtk.vtkPolyDataNormals()
+            self._normals.SetInputData(self.mesh)
+            self._normals.SplittingOff()
+            self._normals.ConsistencyOff()
+            self._normals.AutoOrientNormalsOff()
+            self._normals.ComputeCellNormalsOff()
+            self.mesh_actor = plotter.add_mesh(self._normals, color=MESH_COLOR,
+                                               smooth_shading=True, specular=0.25,
+                                               specular_power=20, name="rig-mesh")
         sk = rig.skeleton
         # No line from a non-deforming root (a ground-level carrier) to its children: that
         # "bone" moves no skin and would cut through the body down to the floor.
@@ -94,10 +114,14 @@ class RigScene:
         self.bones = pv.PolyData(sk.bind_matrices[:, :3, 3].copy())
         if len(child):
             self.bones.lines = lines
-        self.bone_actor = plotter.add_mesh(self.bones, color=BONE_COLOR, line_width=3,
+        self.bone_actor = plotter.add_mesh(self.bones, color=BONE_COLOR,
+                                           line_width=3 if self.has_mesh else 5,
                                            render_lines_as_tubes=False, name="rig-bones",
                                            reset_camera=False)
-        self.bone_actor.SetVisibility(show_skeleton)
+        self.bone_actor.SetVisibility(show_skeleton or not self.has_mesh)
+        self.joint_actor = self.tails = None
+        if not self.has_mesh:
+            self._add_bare_skeleton(plotter)
         self.floor_actor = self._add_floor() if show_floor else None
         self.display_mode = "solid"
         self.weights_shown = False
@@ -106,8 +130,48 @@ class RigScene:
         self.view("front")
 
     # ------------------------------------------------------------------ actors
+    def _add_bare_skeleton(self, plotter):
+        """Joint balls and End-Site tail segments: what a mesh-less rig shows."""
+        model = self.rig.skeleton.bind_matrices
+        self.joints = pv.PolyData(model[:, :3, 3].copy())
+        self.joint_actor = plotter.add_mesh(self.joints, color=BONE_COLOR, point_size=11,
+                                            render_points_as_spheres=True, name="rig-joints",
+                                            reset_camera=False)
+        joints, tails = self.rig.posed_tails(model)
+        n = len(joints)
+        if n:
+            self.tails = pv.PolyData(np.vstack([model[joints, :3, 3], tails]))
+            self.tails.lines = np.column_stack([np.full(n, 2), np.arange(n),
+                                                np.arange(n) + n]).ravel()
+            plotter.add_mesh(self.tails, color=BONE_COLOR, line_width=5, name="rig-tails",
+                             reset_camera=False)
+
+    def _update_bare_skeleton(self, model):
+        self.joints.points[:] = model[:, :3, 3]
+        self.joints.Modified()
+        if self.tails is not None:
+            joints, tails = self.rig.posed_tails(model)
+            self.tails.points[:] = np.vstack([model[joints, :3, 3], tails])
+            self.tails.Modified()
+
+    def rest_points(self, samples=12):
+        """(N, 3) points the default camera and the floor are fitted to: a sample of the
+        mesh's vertices; for a rig without a mesh, its joints and bone tails over its first
+        clip (a BVH skeleton's rest pose is arbitrary, its motion is what is shown), or at
+        bind time when it has no clip."""
+        rig = self.rig
+        if self.has_mesh:
+            return rig.vertices[::max(1, len(rig.vertices) // 4000)]
+        clip = next(iter(rig.clips.values()), None)
+        if clip is None or not clip.tracks:
+            return joint_points(rig, rig.skeleton.bind_matrices)
+        pose = rig.rest_pose()
+        return np.concatenate([joint_points(rig, rig.joint_matrices(clip.sample(t, out=pose)))
+                               for t in np.linspace(0.0, clip.duration, samples)])
+
     def _add_floor(self):
-        lo, hi = self.rig.bounds()
+        points = self.rest_points()
+        lo, hi = points.min(axis=0), points.max(axis=0)
         extent = float(np.max(hi - lo)) or 1.0
         # Wide enough that a walk filmed with a following camera never reaches its edge;
         # cells of a fixed size in model units so motion over the floor reads as speed.
@@ -140,6 +204,9 @@ class RigScene:
         joints inside stay visible) or ``"wireframe"``."""
         if mode not in self.DISPLAY_MODES:
             raise ValueError(f"expected a display mode in {self.DISPLAY_MODES}, got {mode!r}")
+        self.display_mode = mode
+        if self.mesh_actor is None:
+            return
         prop = self.mesh_actor.GetProperty()
         if mode == "wireframe":
             prop.SetRepresentationToWireframe()
@@ -151,7 +218,6 @@ class RigScene:
             prop.SetOpacity(1.0 if mode == "solid" else 0.35)
             prop.SetEdgeVisibility(mode == "translucent")
             prop.SetEdgeColor(0.35, 0.33, 0.30)
-        self.display_mode = mode
 
     def show_weights(self, weights):
         """Colour the mesh by one joint's influence (weight paint view), or back to its plain
@@ -161,6 +227,9 @@ class RigScene:
         ----------
         weights : (V,) float in [0, 1], or None
         """
+        if self.mesh_actor is None:  # nothing to paint on a mesh-less rig
+            self.weights_shown = False
+            return
         mapper = self.mesh_actor.GetMapper()
         if weights is None:
             mapper.ScalarVisibilityOff()
@@ -203,7 +272,9 @@ class RigScene:
     def update_from_matrices(self, model, skin=True):
         """Same as :meth:`update` from model matrices already computed; ``skin=False``
         moves the bones only (the mesh keeps its points)."""
-        if skin:
+        if not self.has_mesh:
+            self._update_bare_skeleton(model)
+        elif skin:
             palette = skinning_matrices(self.rig.skeleton, model)
             self.mesh.points[:] = self.rig.binding.skin(palette)
             self.mesh.GetPoints().Modified()
@@ -233,7 +304,7 @@ class RigScene:
             swinging legs stay in frame.
         """
         if points is None:
-            points = self.rig.vertices[::max(1, len(self.rig.vertices) // 4000)]
+            points = self.rest_points()
         points = np.asarray(points, dtype=float)
         lo, hi = points.min(axis=0), points.max(axis=0)
         center = 0.5 * (lo + hi) if target is None else np.asarray(target, dtype=float)

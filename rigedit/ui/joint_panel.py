@@ -258,7 +258,8 @@ class InfoPanel(QtWidgets.QWidget):
         self.labels["Joints"].setText(str(len(rig.skeleton)))
         self.labels["Bones"].setText(str(rig.num_bones))
         self.labels["Clips"].setText(str(len(rig.clips)))
-        self.labels["Influences"].setText(f"{rig.binding.indices.shape[1]} per vertex")
+        self.labels["Influences"].setText(f"{rig.binding.indices.shape[1]} per vertex"
+                                          if len(rig.vertices) else "- (no mesh)")
 
     def show_selection(self, rig, joint):
         if joint is None:

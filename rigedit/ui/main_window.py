@@ -212,6 +212,11 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         self.overlay.AddActor(self.scene.bone_actor)
         self.scene.view("front", angle=35)
         self.scene.set_display_mode(self.display_mode())
+        # a rig without a mesh (a BVH skeleton) has no skin to shade or paint
+        for act in (self.weights_action, *self.display_actions.values()):
+            act.setEnabled(self.scene.has_mesh)
+        if not self.scene.has_mesh and self._weights_view:
+            self.set_weights_view(False)
         self.scene.set_floor_visible(self.floor_action.isChecked())
         self.radius = gizmo_radius(rig)
         self.gizmos = JointGizmos(self.plotter, self.scene.joint_positions, self.radius,

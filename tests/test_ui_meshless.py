@@ -1,0 +1,129 @@
+"""A rig without a mesh (a BVH skeleton) in the editor: bones and joint spheres, drags,
+keys, playback, recording."""
+import numpy as np
+import pytest
+
+from rigedit.io.bvh import load_bvh
+from ui_window_fixture import editor_window
+
+pytestmark = [pytest.mark.ui, pytest.mark.filterwarnings("error::RuntimeWarning")]
+
+BVH = """HIERARCHY
+ROOT Hips
+{
+  OFFSET 0 90 0
+  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+  JOINT Spine
+  {
+    OFFSET 0 20 0
+    CHANNELS 3 Zrotation Xrotation Yrotation
+    JOINT Head
+    {
+      OFFSET 0 40 0
+      CHANNELS 3 Zrotation Xrotation Yrotation
+      End Site
+      {
+        OFFSET 0 20 0
+      }
+    }
+  }
+  JOINT LeftLeg
+  {
+    OFFSET 10 0 0
+    CHANNELS 3 Zrotation Xrotation Yrotation
+    JOINT LeftFoot
+    {
+      OFFSET 0 -45 0
+      CHANNELS 3 Zrotation Xrotation Yrotation
+      End Site
+      {
+        OFFSET 0 -40 5
+      }
+    }
+  }
+}
+MOTION
+Frames: 3
+Frame Time: 0.5
+0 90 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0
+0 95 10 0 0 0 0 20 0 0 0 0 30 0 0 0 0 0
+0 90 20 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0
+"""
+
+
+@pytest.fixture
+def bvh_window(qtbot, tmp_path):
+    path = tmp_path / "walk.bvh"
+    path.write_text(BVH)
+    rig = load_bvh(path, scale=0.01)
+    with editor_window(qtbot, rig) as w:
+        yield w
+
+
+def _fire_drag(widget, new_center):
+    widget.InvokeEvent("StartInteractionEvent")
+    widget.SetCenter(*new_center)
+    widget.InvokeEvent("InteractionEvent")
+    widget.InvokeEvent("EndInteractionEvent")
+
+
+def test_opens_with_bones_spheres_and_no_mesh(bvh_window):
+    w = bvh_window
+    rig = w.document.rig
+    assert w.scene.mesh_actor is None and w.scene.mesh.n_points == 0
+    assert len(w.gizmos.widgets) == len(rig.skeleton) == 5
+    # the first frame of the motion is shown, not the rest pose
+    first = rig.joint_matrices(rig.clips["take"].sample(0.0))[:, :3, 3]
+    np.testing.assert_allclose(w.gizmos.center(0), first[0], atol=1e-9)
+    np.testing.assert_allclose(w.scene.bones.points, first, atol=1e-6)
+    assert w.info_panel.labels["Vertices"].text() == "0"
+    assert not w.weights_action.isEnabled()
+    w.set_weights_view(True)  # asked anyway: nothing to paint, nothing breaks
+    assert not w.scene.weights_shown
+    # the 3D view shows something besides the background: bones drawn
+    img = w.plotter.screenshot(return_img=True)
+    assert np.ptp(img.reshape(-1, img.shape[-1])[:, :3], axis=0).max() > 50
+
+
+def test_drag_a_joint_key_it_and_play(bvh_window, qtbot):
+    w = bvh_window
+    doc = w.document
+    rig = doc.rig
+    sk = rig.skeleton
+    head, spine = sk.joint_index("Head"), sk.joint_index("Spine")
+    w.chain_length = 1
+    w.timeline.set_time(1.0)  # the last frame
+    start = w.gizmos.center(head).copy()
+    _fire_drag(w.gizmos.widgets[head], start + np.array([0.3, 0.0, 0.0]))
+    assert len(doc.undo_stack) == 1 and doc.selection == head
+    dragged = rig.joint_matrices(doc.pose)[:, :3, 3]
+    assert dragged[head, 0] > start[0] + 0.05  # the head swung towards the drag
+    # a rotation, not a stretch: the bone keeps its length
+    assert np.isclose(np.linalg.norm(dragged[head] - dragged[spine]), 0.4, atol=1e-6)
+    # the head's End Site rides along the bone: 0.2 further in the spine -> head direction
+    tail = w.scene.tails.points[len(w.scene.tails.points) // 2]
+    np.testing.assert_allclose(tail, dragged[head] + 0.5 * (dragged[head] - dragged[spine]),
+                               atol=1e-6)
+    # key it at 1 s (the drag turned the spine: key all joints), scrub away and back: the
+    # keys hold the dragged pose
+    w.timeline.insert_key(all_joints=True)
+    w.timeline.set_time(0.0)
+    assert np.abs(rig.joint_matrices(doc.pose)[head, :3, 3] - dragged[head]).max() > 0.05
+    w.timeline.set_time(1.0)
+    np.testing.assert_allclose(rig.joint_matrices(doc.pose)[:, :3, 3], dragged, atol=1e-6)
+    # playback moves the skeleton on screen
+    w.timeline.set_time(0.0)
+    before = w.scene.bones.points.copy()
+    w.timeline.play()
+    qtbot.waitUntil(lambda: np.abs(w.scene.bones.points - before).max() > 1e-3, timeout=5000)
+    w.timeline.pause()
+
+
+def test_record_video_of_a_skeleton(bvh_window, tmp_path):
+    import imageio.v2 as imageio
+
+    out = tmp_path / "take.gif"
+    n = bvh_window.record_video(out, fps=6, size=(160, 120))
+    frames = imageio.mimread(out)
+    assert n == len(frames) == 6
+    assert np.abs(frames[0].astype(int) - frames[3].astype(int)).max() > 50
