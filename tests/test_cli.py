@@ -73,7 +73,7 @@ def test_render_end_to_end_mp4_and_gif(rig_dir, tmp_path):
     frames = iio.imread(mp4)
     assert frames.shape == (8, 64, 96, 3)   # duration 1 s at 8 fps
     # The clip bends the cylinder: the first and middle frames differ.
-    assert np.abs(frames[0].astype(int) - frames[4].astype(int)).mean() > 1.0
+    assert np.abs(frames[0].astype(int) - frames[4].astype(int)).mean() > 5.5  # measured 11.1
     gif = tmp_path / "bend.gif"
     assert main(["render", "bend", "--rig", str(rig_dir), "-o", str(gif), "--fps", "4",
                  "--duration", "0.5", "--size", "64x48", "--angle", "90", "-q"]) == 0

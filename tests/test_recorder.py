@@ -36,7 +36,7 @@ def test_mp4_has_the_requested_frames_and_size_and_they_move(rig, tmp_path):
     assert frames.shape == (10, SIZE[1], SIZE[0], 3)
     # the cylinder bends 60 degrees at t = 0.5: that frame differs from the first one
     diff = np.abs(frames[5].astype(int) - frames[0].astype(int)).mean()
-    assert diff > 1.0
+    assert diff > 6.5  # measured 13.0 (mean absolute difference, 0-255 per channel)
     assert [p.name for p in tmp_path.iterdir()] == ["bend.mp4"]
 
 
@@ -45,7 +45,7 @@ def test_gif_with_orbit(rig, tmp_path):
     assert record_clip(rig, None, path, fps=8, duration=0.5, size=SIZE, orbit=90) == 4
     frames = read_frames(path)
     assert frames.shape[:3] == (4, SIZE[1], SIZE[0])
-    assert np.abs(frames[3].astype(int) - frames[0].astype(int)).mean() > 1.0
+    assert np.abs(frames[3].astype(int) - frames[0].astype(int)).mean() > 8.5  # measured 16.9
 
 
 def test_cancel_keeps_an_existing_file_and_leaves_no_temporary(rig, tmp_path):
@@ -64,7 +64,7 @@ def test_camera_dict_is_used(rig, tmp_path):
     record_clip(rig, None, b, fps=4, duration=0.25, size=SIZE,
                 camera={"position": (6, 1.5, 0), "focal_point": (0, 1.5, 0), "up": (0, 1, 0)})
     fa, fb = read_frames(a)[0], read_frames(b)[0]
-    assert np.abs(fa.astype(int) - fb.astype(int)).mean() > 1.0
+    assert np.abs(fa.astype(int) - fb.astype(int)).mean() > 11.0  # measured 22.0
 
 
 def test_rejects_bad_arguments(rig, tmp_path):

@@ -28,7 +28,7 @@ def test_app_screenshot(tmp_path):
     a = a.reshape(h, w, 3).astype(int)
     # The mesh (a warm beige) fills part of the left-hand 3D view, not the right-hand panels.
     beige = (a[..., 0] > a[..., 2] + 25) & (a[..., 0] > 90) & (a[..., 1] > 70)
-    assert beige[:, : int(0.6 * w)].mean() > 0.02
+    assert 0.025 < beige[:, : int(0.6 * w)].mean() < 0.055  # measured 0.036-0.039
     assert beige[:, int(0.85 * w):].mean() < 0.01
 
 

@@ -225,5 +225,6 @@ def test_export_video_dialog_records_what_it_was_asked(window, qtbot, tmp_path, 
     assert window.last_error is None
     frames = iio.imread(out, index=None)
     assert frames.shape[:3] == (6, 120, 160)       # 0.2 s to 0.8 s at 10 frames/s
-    assert np.abs(frames[-1].astype(int) - frames[0].astype(int)).mean() > 0.5  # it moves
+    # it moves (measured 2.1: the head nods in a small part of the frame)
+    assert np.abs(frames[-1].astype(int) - frames[0].astype(int)).mean() > 1.2
     assert "Recorded 6 frames" in window.statusBar().currentMessage()

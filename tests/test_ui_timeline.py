@@ -210,7 +210,7 @@ def test_record_video_from_the_editor(window, tmp_path, qtbot):
     assert n == 10
     frames = np.stack(list(iio.imiter(path)))
     assert frames.shape == (10, 144, 192, 3)
-    assert np.abs(frames[5].astype(int) - frames[0].astype(int)).mean() > 0.5
+    assert np.abs(frames[5].astype(int) - frames[0].astype(int)).mean() > 2.5  # measured 4.3
     # the editor is still usable: scrubbing still poses the interactive mesh
     before = np.array(window.scene.mesh.points)
     window.timeline.set_time(0.5)

@@ -51,7 +51,7 @@ def test_sphere_interaction_moves_subtree_vertices_only(window):
     moving, still = _moved_and_still(rig, top)
     assert moving.sum() > 10 and still.sum() > 10
     shift = np.linalg.norm(after - before, axis=1)
-    assert np.median(shift[moving]) > 0.01 * rig.height()
+    assert np.median(shift[moving]) > 0.1 * rig.height()  # measured 0.163
     assert shift[still].max() < 1e-5
     assert len(doc.undo_stack) == 1 and doc.selection == j
     # the sphere snapped onto the joint, which stays at its bone length from the parent
@@ -279,9 +279,9 @@ def test_screenshot_shows_the_model(window, tmp_path):
     assert a.std() > 10  # not blank
     diff = np.abs(a - b).sum(axis=2) > 30
     ys, xs = np.nonzero(diff)
-    # the mesh covers a good part of the 3D view (measured: about 9% on the default rig)
+    # the mesh covers a part of the 3D view (measured 5.5% on the quadruped, 1100x750 window)
     view = window.plotter.geometry()
-    assert diff.sum() / (view.width() * view.height()) > 0.05
+    assert 0.04 < diff.sum() / (view.width() * view.height()) < 0.08
     # ... within the 3D view, around its middle
     cx, cy = xs.mean(), ys.mean()
     assert view.left() < cx < view.right() and view.top() < cy < view.bottom() + 60
