@@ -122,6 +122,7 @@ def two_bone(ancestor=None, names=("root", "tip"), mode=4, **options):
         Triangle list, strip or fan.
     options : positions ("float", "quantized"), normals ("float", "byte"), layout
         ("separate", "interleaved"), sparse (bool), weights ("float", "ubyte", "ushort"),
+        two_sets (bool: JOINTS_1/WEIGHTS_1 as well),
         interpolation ("LINEAR", "STEP", "CUBICSPLINE").
 
     Returns
@@ -160,7 +161,13 @@ def two_bone(ancestor=None, names=("root", "tip"), mode=4, **options):
         min=(pos_arr.min(0)).tolist(), max=(pos_arr.max(0)).tolist())
     attrs["JOINTS_0"] = b.accessor(jt, "uint8")
     kind = options.get("weights", "float")
-    if kind == "float":
+    if options.get("two_sets"):
+        # 8 influence slots: each joint's weight split over JOINTS_0 and JOINTS_1
+        attrs["JOINTS_1"] = b.accessor(np.tile([1, 0, 0, 0], (8, 1)), "uint16")
+        attrs["WEIGHTS_0"] = b.accessor(wt * [1.0, 0.25, 0, 0], "float32")
+        attrs["WEIGHTS_1"] = b.accessor(np.stack([wt[:, 1] * 0.75, np.zeros(8), np.zeros(8),
+                                                  np.zeros(8)], 1), "float32")
+    elif kind == "float":
         attrs["WEIGHTS_0"] = b.accessor(wt, "float32")
     else:
         top = 255 if kind == "ubyte" else 65535

@@ -74,6 +74,7 @@ FEATURES = [
     dict(sparse=True, positions="quantized"),
     dict(weights="ubyte"),
     dict(weights="ushort", normals="byte"),
+    dict(two_sets=True),
     dict(mode=5),
     dict(mode=6),
     dict(interpolation="STEP"),
@@ -250,3 +251,4 @@ def test_wrong_gltf_json_version(tmp_path):
     path.write_text(json.dumps({"asset": {"version": "1.0"}}))
     with pytest.raises(RigFileError, match="version 2.x"):
         load_gltf(path)
+

@@ -207,3 +207,49 @@ def test_khronos_validator_finds_nothing(tmp_path, source, ext):
     issues = report["issues"]
     assert issues["numErrors"] == 0 and issues["numWarnings"] == 0, issues["messages"][:5]
     assert report["info"]["animationCount"] == len(rig.clips)
+
+
+def test_eight_influences_and_several_primitives(tmp_path):
+    """JOINTS_1/WEIGHTS_1 and two primitives with two materials survive a round trip."""
+    from gltf_builder import two_bone
+
+    b, _ = two_bone(two_sets=True)
+    prim = b.doc["meshes"][0]["primitives"][0]
+    second = json.loads(json.dumps(prim))
+    second["material"] = 1
+    prim["material"] = 0
+    b.doc["meshes"][0]["primitives"].append(second)
+    b.doc["materials"] = [{"name": "red", "pbrMetallicRoughness": {"baseColorFactor":
+                                                                  [1, 0, 0, 1]}},
+                          {"name": "blue", "pbrMetallicRoughness": {"baseColorFactor":
+                                                                   [0, 0, 1, 0.5]}}]
+    rig = load_gltf(b.write(tmp_path / "in.glb"))
+    assert len(rig.vertices) == 16 and list(rig.surface.primitive_material) == [0, 1]
+    assert np.array_equal(rig.surface.vertex_primitive, np.repeat([0, 1], 8))
+    out = save_gltf(rig, tmp_path / "out.glb")
+    g = pygltflib.GLTF2().load(str(out))
+    assert [p.material for p in g.meshes[0].primitives] == [0, 1]
+    back = load_gltf(out)
+    assert_same_rig(rig, back)
+    np.testing.assert_allclose(back.surface.materials[1].base_color, [0, 0, 1, 0.5])
+    check_structure(out)
+    if os.environ.get("RIGEDIT_GLTF_VALIDATOR") and shutil.which("node"):
+        run = subprocess.run(["node", os.environ["RIGEDIT_GLTF_VALIDATOR"], str(out)],
+                             capture_output=True, text=True, timeout=120)
+        issues = json.loads(run.stdout)["issues"]
+        assert issues["numErrors"] == 0 and issues["numWarnings"] == 0, issues["messages"][:5]
+
+
+def test_six_distinct_influences_write_two_sets(tmp_path):
+    rig = rigedit.load_rig("humanoid")
+    rng = np.random.default_rng(0)
+    v, j = len(rig.vertices), len(rig.skeleton)
+    idx = np.argsort(rng.random((v, j)), axis=1)[:, :6]
+    rig.bind(idx, rng.random((v, 6)) + 0.01)
+    rig.clips = {"walk": rig.clips["walk"]}
+    out = save_gltf(rig, tmp_path / "six.glb")
+    g = pygltflib.GLTF2().load(str(out))
+    assert g.meshes[0].primitives[0].attributes.JOINTS_1 is not None
+    back = load_gltf(out)
+    assert_same_rig(rig, back)
+    check_structure(out)
