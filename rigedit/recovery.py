@@ -129,7 +129,8 @@ class RecoveryEntry:
     def describe(self):
         """One line for the user: the rig, where it came from and when it was saved."""
         when = _time.strftime("%Y-%m-%d %H:%M", _time.localtime(self.info.get("saved_at", 0)))
-        origin = self.info.get("original_path") or "never saved"
+        origin = "bundled character" if self.info.get("bundled") else \
+            self.info.get("original_path") or "never saved"
         return f"{self.info.get('name', 'rig')} ({origin}), autosaved {when}"
 
 

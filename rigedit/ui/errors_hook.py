@@ -172,19 +172,24 @@ class ErrorDisplay:
         self.label = QtWidgets.QLabel()
         self.label.setStyleSheet("color: #ff6b6b; font-weight: bold")
         self.label.setVisible(False)
-        window.statusBar().addPermanentWidget(self.label, 1)
+        self.label.setMaximumWidth(640)  # long messages are cut; the tooltip has it all
+        window.statusBar().insertPermanentWidget(0, self.label)
 
     def show(self, what, summary, saved=False):
-        what = what or "An operation"
+        """Show one error: ``what`` failed (None: not known, as for a Qt slot, whose
+        function ``summary`` names) with ``summary`` from :func:`describe`."""
         log = recovery.log_path()
         self.count += 1
-        self.label.setText(f"Error: {what} failed: {summary}")
-        self.label.setToolTip(f"Details in {log}")
+        headline = f"Error: {what} failed: {summary}" if what else \
+            f"Unexpected error: {summary}"
+        self.label.setText(headline)
+        self.label.setToolTip(f"{headline}\nDetails in {log}")
         self.label.setVisible(True)
-        self.window.statusBar().showMessage(f"Error: {what} failed; details in {log}")
-        text = (f"{what} failed unexpectedly:\n{summary}\n\n"
-                + ("Your work was written to a recovery file. " if saved else "")
-                + f"The details are in {log}.")
+        self.window.statusBar().showMessage(f"Error; details in {log}")
+        text = (f"{what} failed unexpectedly:\n{summary}" if what
+                else f"An unexpected error happened:\n{summary}")
+        text += ("\n\n" + ("Your work was written to a recovery file. " if saved else "")
+                 + f"The details are in {log}.")
         if self.count > 1:
             text += f"\n\n({self.count} errors so far)"
         box = self.dialog

@@ -12,7 +12,7 @@ from PyQt5 import QtCore
 
 from ..model.weights import compute_weights
 
-__all__ = ["Cancelled", "Job", "weights_in_chunks"]
+__all__ = ["Cancelled", "Job", "JobsMixin", "weights_in_chunks"]
 
 
 class Cancelled(Exception):
@@ -70,6 +70,75 @@ class Job(QtCore.QThread):
             self.failed.emit(f"unexpected {summary}; details in the log")
         else:
             self.succeeded.emit(result)
+
+
+class JobsMixin:
+    """:meth:`run_job` and :meth:`cancel_job` of :class:`~rigedit.ui.main_window.MainWindow`
+    (which has ``job``, ``progress``, ``cancel_button``, ``status``, ``error``,
+    ``report_exception`` and ``_update_undo_actions``)."""
+
+    def run_job(self, label, fn, on_done, on_cancel=None):
+        """Run ``fn(report)`` off the UI thread with a progress bar and a Cancel button;
+        ``on_done(result)`` runs on the main thread. Returns the :class:`Job`."""
+        if self.job is not None:
+            self.error("Busy", f"busy with '{self.job.label}': wait for it to finish, or "
+                               f"cancel it, then try '{label}' again")
+            return None
+        job = Job(label, fn, self)
+        self.job = job
+        self.progress.setRange(0, 100)
+        self.progress.setValue(0)
+        self.progress.setFormat(f"{label}: %p%")
+        self.progress.setVisible(True)
+        self.cancel_button.setVisible(True)
+
+        def progress(p):
+            if p < 0:
+                self.progress.setRange(0, 0)
+            else:
+                self.progress.setRange(0, 100)
+                self.progress.setValue(p)
+
+        def finish():
+            self.job = None
+            self.progress.setVisible(False)
+            self.cancel_button.setVisible(False)
+            self._update_undo_actions()
+
+        def ok(result):
+            finish()
+            try:
+                on_done(result)
+            except ValueError as exc:
+                self.error(label, str(exc))
+            except Exception:  # noqa: BLE001 - a bug: shown and logged, the editor goes on
+                self.report_exception(label)
+
+        def failed(msg):
+            finish()
+            if on_cancel:
+                on_cancel()
+            self.error(label, msg)  # after on_cancel, so its status does not hide the error
+
+        def cancelled():
+            finish()
+            self.status(f"{label}: cancelled")
+            if on_cancel:
+                on_cancel()
+
+        job.progress.connect(progress)
+        job.succeeded.connect(ok)
+        job.failed.connect(failed)
+        job.cancelled.connect(cancelled)
+        job.finished.connect(job.deleteLater)
+        self.status(f"{label}...")
+        job.start()
+        self._update_undo_actions()
+        return job
+
+    def cancel_job(self):
+        if self.job is not None:
+            self.job.cancel()
 
 
 def weights_in_chunks(vertices, skeleton, method="idw", report=None):

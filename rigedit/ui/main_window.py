@@ -22,7 +22,7 @@ from .drag import DragMixin
 from .menus import MenusMixin
 from .file_actions import FileActions
 from .joint_panel import InfoPanel, JointPanel
-from .jobs import Job
+from .jobs import JobsMixin
 
 __all__ = ["MainWindow", "default_rig"]
 
@@ -50,7 +50,7 @@ def default_rig():
         return demo_rig(), f"bundled quadruped not available ({exc}); showing a demo creature"
 
 
-class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
+class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
     """The rig editor.
 
     Parameters
@@ -404,70 +404,6 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         if self.document.selection is not None:
             self.document.reset_joint(self.document.selection)
 
-    # ================================================================== jobs
-    def run_job(self, label, fn, on_done, on_cancel=None):
-        """Run ``fn(report)`` off the UI thread with a progress bar and a Cancel button;
-        ``on_done(result)`` runs on the main thread. Returns the :class:`Job`."""
-        if self.job is not None:
-            self.error("Busy", f"busy with '{self.job.label}': wait for it to finish, or "
-                               f"cancel it, then try '{label}' again")
-            return None
-        job = Job(label, fn, self)
-        self.job = job
-        self.progress.setRange(0, 100)
-        self.progress.setValue(0)
-        self.progress.setFormat(f"{label}: %p%")
-        self.progress.setVisible(True)
-        self.cancel_button.setVisible(True)
-
-        def progress(p):
-            if p < 0:
-                self.progress.setRange(0, 0)
-            else:
-                self.progress.setRange(0, 100)
-                self.progress.setValue(p)
-
-        def finish():
-            self.job = None
-            self.progress.setVisible(False)
-            self.cancel_button.setVisible(False)
-            self._update_undo_actions()
-
-        def ok(result):
-            finish()
-            try:
-                on_done(result)
-            except ValueError as exc:
-                self.error(label, str(exc))
-            except Exception:  # noqa: BLE001 - a bug: shown and logged, the editor goes on
-                self.report_exception(label)
-
-        def failed(msg):
-            finish()
-            if on_cancel:
-                on_cancel()
-            self.error(label, msg)  # after on_cancel, so its status does not hide the error
-
-        def cancelled():
-            finish()
-            self.status(f"{label}: cancelled")
-            if on_cancel:
-                on_cancel()
-
-        job.progress.connect(progress)
-        job.succeeded.connect(ok)
-        job.failed.connect(failed)
-        job.cancelled.connect(cancelled)
-        job.finished.connect(job.deleteLater)
-        self.status(f"{label}...")
-        job.start()
-        self._update_undo_actions()
-        return job
-
-    def cancel_job(self):
-        if self.job is not None:
-            self.job.cancel()
-
     # ================================================================== messages
     def status(self, text, timeout=0):
         self.statusBar().showMessage(text, timeout)
@@ -482,7 +418,7 @@ class MainWindow(MenusMixin, DragMixin, QtWidgets.QMainWindow):
         for recovery first, as the state after a bug may not be trustworthy; then
         :class:`~.errors_hook.ErrorDisplay` shows it."""
         saved = self.autosave.crash_save()
-        self.last_error = f"{what or 'An operation'} failed: {summary}"
+        self.last_error = f"{what} failed: {summary}" if what else summary
         self.error_display.show(what, summary, saved)
 
     def error(self, title, message):
