@@ -1,7 +1,11 @@
 import os
 import socket
+import tempfile
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
+# The editor writes recovery entries and its error log to the user's cache folder
+# ($XDG_CACHE_HOME/rigedit): keep the tests' (and their subprocesses') out of the real one.
+os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp(prefix="rigedit-test-cache-")
 
 import pytest
 
