@@ -1,4 +1,6 @@
+import atexit
 import os
+import shutil
 import socket
 import tempfile
 
@@ -6,6 +8,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 # The editor writes recovery entries and its error log to the user's cache folder
 # ($XDG_CACHE_HOME/rigedit): keep the tests' (and their subprocesses') out of the real one.
 os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp(prefix="rigedit-test-cache-")
+atexit.register(shutil.rmtree, os.environ["XDG_CACHE_HOME"], True)
 
 import pytest
 
