@@ -35,27 +35,30 @@ J, K = 40, 4
 BYTES_PER_VERTEX = 12 + 4 * K + 4 * K + 12  # rest, indices, weights, output
 
 
-def median_ms(fn, repeat):
+def timed_ms(fn, repeat):
+    """(median, best) time of one call in ms, after one warm-up call."""
     fn()
     times = []
     for _ in range(repeat):
         t0 = time.perf_counter()
         fn()
         times.append(time.perf_counter() - t0)
-    return 1e3 * float(np.median(times))
+    return 1e3 * float(np.median(times)), 1e3 * float(np.min(times))
 
 
 def bandwidth_gbs(nbytes=256_000_000, repeat=7):
+    """(median, best) read + write bandwidth of np.copyto in GB/s."""
     a = np.ones(nbytes // 8)
     b = np.empty_like(a)
-    ms = median_ms(lambda: np.copyto(b, a), repeat)
-    return 2 * nbytes / (ms * 1e-3) / 1e9  # read + write
+    med, best = timed_ms(lambda: np.copyto(b, a), repeat)
+    return 2 * nbytes / (med * 1e-3) / 1e9, 2 * nbytes / (best * 1e-3) / 1e9
 
 
 def random_palettes(rng, n):
     pals = np.tile(np.eye(4), (n, J, 1, 1))
     for i in range(n):
-        pals[i, :, :3, :3] = Rotation.random(J, random_state=int(rng.integers(1 << 30))).as_matrix()
+        seed = int(rng.integers(1 << 30))
+        pals[i, :, :3, :3] = Rotation.random(J, random_state=seed).as_matrix()
         pals[i, :, :3, 3] = rng.normal(size=(J, 3))
     return pals
 
@@ -69,11 +72,13 @@ def main(repeat_scale=1.0):
     bw = bandwidth_gbs()
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cpus, "
           f"numpy {np.__version__}, numba {kernels.numba.__version__}, one BLAS thread")
-    print(f"memory-copy bandwidth: {bw:.1f} GB/s (np.copyto of 256 MB, read + write); floor = "
-          f"{BYTES_PER_VERTEX} bytes/vertex at that rate")
+    print(f"memory-copy bandwidth: median {bw[0]:.1f} GB/s, best {bw[1]:.1f} GB/s (np.copyto "
+          f"of 256 MB, read + write); floor = {BYTES_PER_VERTEX} bytes/vertex at that rate")
     cols = ["floor", "LBS 1t", "LBS 2t", "LBS numpy", "dense ref", "DQS 1t", "DQS 2t",
-            "DQS numpy", "LBS1/floor", "DQS1/LBS1"]
-    print(f"{'vertices':>9} | " + " | ".join(f"{c:>10}" for c in cols) + "   (ms per frame)")
+            "DQS numpy"]
+    print("ms per frame, median / best of the run; ratios of the medians (and of the bests)")
+    print(f"{'vertices':>9} | " + " | ".join(f"{c:>13}" for c in cols)
+          + f" | {'LBS1/floor':>13} | {'DQS1/LBS1':>13}")
     for v in (10_000, 100_000, 1_000_000):
         rest = rng.normal(size=(v, 3))
         idx, w = top_k_influences(rng.random((v, J)) ** 8, K)
@@ -96,20 +101,22 @@ def main(repeat_scale=1.0):
         ref_dqs = binding.skin(p0, method="dqs", backend="numpy").copy()
         assert np.allclose(binding.skin(p0, method="dqs", backend="numba"), ref_dqs, atol=1e-4)
         repeat = max(3, int(repeat_scale * (200 if v <= 10_000 else 60 if v <= 100_000 else 15)))
-        row = {"floor": v * BYTES_PER_VERTEX / (bw * 1e9) * 1e3}
+        row = {"floor": tuple(v * BYTES_PER_VERTEX / (b * 1e9) * 1e3 for b in bw)}
         for threads in (1, 2):
             binding.threads = threads
-            row[f"LBS {threads}t"] = median_ms(lambda: binding.skin(palette(), backend="numba"),
-                                              repeat)
-            row[f"DQS {threads}t"] = median_ms(
+            row[f"LBS {threads}t"] = timed_ms(lambda: binding.skin(palette(), backend="numba"),
+                                             repeat)
+            row[f"DQS {threads}t"] = timed_ms(
                 lambda: binding.skin(palette(), method="dqs", backend="numba"), repeat)
-        row["LBS numpy"] = median_ms(lambda: binding.skin(palette(), backend="numpy"), repeat)
-        row["dense ref"] = median_ms(dense_frame, max(3, repeat // 4))
-        row["DQS numpy"] = median_ms(
+        row["LBS numpy"] = timed_ms(lambda: binding.skin(palette(), backend="numpy"), repeat)
+        row["dense ref"] = timed_ms(dense_frame, max(3, repeat // 4))
+        row["DQS numpy"] = timed_ms(
             lambda: binding.skin(palette(), method="dqs", backend="numpy"), max(3, repeat // 4))
-        row["LBS1/floor"] = row["LBS 1t"] / row["floor"]
-        row["DQS1/LBS1"] = row["DQS 1t"] / row["LBS 1t"]
-        print(f"{v:>9,} | " + " | ".join(f"{row[c]:>10.3f}" for c in cols), flush=True)
+        ratios = [tuple(a / b for a, b in zip(row[x], row[y]))
+                  for x, y in (("LBS 1t", "floor"), ("DQS 1t", "LBS 1t"))]
+        print(f"{v:>9,} | " + " | ".join(f"{row[c][0]:>6.3f}/{row[c][1]:<6.3f}" for c in cols)
+              + " | " + " | ".join(f"{r[0]:>5.2f} ({r[1]:.2f})".rjust(13) for r in ratios),
+              flush=True)
 
 
 if __name__ == "__main__":

@@ -136,3 +136,13 @@ def test_palette_split_recovers_rigid_motion_and_scale():
     assert not rigid
     out = dqs_skin(np.zeros((1, 3)), [[0]], [[1.0]], dq[:1])
     assert np.allclose(out[0], palette[0, :3, 3])
+
+
+def test_matrix_to_quaternion_matches_scipy_up_to_sign():
+    from rigedit.model.dqs import matrix_to_quaternion
+
+    rots = Rotation.concatenate([Rotation.random(500, random_state=2),
+                                 Rotation.from_rotvec(np.pi * np.eye(3)),  # half turns
+                                 Rotation.identity()])
+    q = matrix_to_quaternion(rots.as_matrix())
+    assert np.allclose(np.abs(np.einsum("ji,ji->j", q, rots.as_quat())), 1.0, atol=1e-12)

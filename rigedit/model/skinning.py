@@ -18,8 +18,10 @@ except ImportError:  # pragma: no cover - SciPy moved it; fall back to the publi
     _csr_matvecs = None
 
 __all__ = ["SkinBinding", "linear_blend_skin", "top_k_influences", "dense_weights", "METHODS",
-           "BACKENDS"]
+           "BACKENDS", "vertex_normals"]
 
+#: A skinning matrix whose 3x3 ``A`` has ``AᵀA`` this close to the identity is rigid for DQS.
+DQS_RIGID_TOL = 1e-6
 #: Skinning methods: linear blend, dual quaternion.
 METHODS = ("lbs", "dqs")
 #: Where a frame is computed: None picks the compiled kernels once they are loaded, numpy
@@ -59,6 +61,29 @@ def top_k_influences(weights, k):
     vals[empty, 0] = 1.0
     total[empty] = 1.0
     return idx.astype(np.int32), vals / total
+
+
+def vertex_normals(vertices, faces):
+    """Area-weighted unit vertex normals of a triangle mesh (zero for unused vertices).
+
+    Parameters
+    ----------
+    vertices : (V, 3) float
+    faces : (F, 3) int
+
+    Returns
+    -------
+    normals : (V, 3) float64
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    # the cross product's length is twice the triangle's area: larger faces weigh more
+    face_n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    n = np.zeros_like(v)
+    for corner in range(3):
+        np.add.at(n, f[:, corner], face_n)
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
 
 
 def dense_weights(indices, values, num_joints):
@@ -131,6 +156,8 @@ class SkinBinding:
         self._weights32 = np.ascontiguousarray(self.weights, dtype=np.float32)
         self._dq = np.empty((self.num_joints, 8), dtype=np.float32)
         self._scale = np.empty((self.num_joints, 9), dtype=np.float32)
+        self._rest_normals32 = None  # set by bind_normals
+        self._out_normals = None
         #: Threads of the compiled kernels: None picks one for small meshes, all for big ones
         #: (see ``skinning_kernels.PARALLEL_MIN_VERTICES``).
         self.threads = None
@@ -216,6 +243,49 @@ class SkinBinding:
         res += b[:, :, 3]
         return res
 
+    def bind_normals(self, rest_normals):
+        """Keep unit rest normals, (V, 3), for :meth:`skin_with_normals` (for example
+        ``vertex_normals(rest_vertices, faces)``)."""
+        n = np.asarray(rest_normals, dtype=np.float64)
+        if n.shape != self.rest_vertices.shape:
+            raise ValueError(f"expected rest normals of shape {self.rest_vertices.shape}, got "
+                             f"{n.shape}")
+        self._rest_normals32 = np.ascontiguousarray(n, dtype=np.float32)
+        self._out_normals = np.empty_like(self._rest_normals32)
+
+    def skin_with_normals(self, palette, backend=None):
+        """LBS vertex positions and normals in one pass: each vertex's blended 3x3 applied to
+        its rest normal, renormalised (exact for rotations and uniform scale, as shading
+        needs; not the inverse transpose under non-uniform scale). Needs :meth:`bind_normals`.
+
+        Parameters
+        ----------
+        palette : (J, 4, 4) float
+        backend : {None, "numba", "numpy"}
+
+        Returns
+        -------
+        vertices, normals : (V, 3) float32 each
+            Internal buffers that the next call overwrites.
+        """
+        if self._rest_normals32 is None:
+            raise ValueError("no rest normals: call bind_normals first")
+        kernels = self._kernels(backend)
+        res, nrm = self._out, self._out_normals
+        if kernels is not None:
+            self._palette[:] = np.asarray(palette)[:, :3, :].reshape(-1, 12)
+            kernels.run("lbs_normals", len(res), self.threads, self._rest32,
+                        self._rest_normals32, self._indices32, self._weights32, self._palette,
+                        res, nrm)
+            return res, nrm
+        self.skin(palette, backend="numpy")  # fills self._blend with each vertex's 3x4
+        b = self._blend.reshape(-1, 3, 4)
+        rn = self._rest_normals32
+        np.einsum("vij,vj->vi", b[:, :, :3], rn, out=nrm)
+        length = np.linalg.norm(nrm, axis=1, keepdims=True)
+        np.divide(nrm, length, out=nrm, where=length > 0)
+        return res, nrm
+
     def skin_dqs(self, palette, out=None, backend=None):
         """Dual-quaternion skinned vertex positions (see :mod:`rigedit.model.dqs` for the
         antipodality and scale handling).
@@ -233,14 +303,18 @@ class SkinBinding:
         vertices : (V, 3) float32 (or ``out``)
         """
         kernels = self._kernels(backend)
-        dq, scale, has_scale = palette_dual_quaternions(palette)
         res = self._output(out)
         if kernels is not None and res.dtype == np.float32 and res.flags.c_contiguous:
-            self._dq[:] = dq
-            self._scale[:] = scale.reshape(-1, 9)
+            palette = np.ascontiguousarray(palette, dtype=np.float64)
+            has_scale = not kernels.rigid_dual_quaternions(palette, DQS_RIGID_TOL, self._dq)
+            if has_scale:
+                dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
+                self._dq[:] = dq
+                self._scale[:] = scale.reshape(-1, 9)
             kernels.run("dqs", len(res), self.threads, self._rest32, self._indices32,
                         self._weights32, self._dq, self._scale, has_scale, res)
             return res
+        dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
         res[:] = dqs_skin(self.rest_vertices, self.indices, self.weights, dq,
                           scale if has_scale else None)
         return res
