@@ -160,3 +160,19 @@ def test_interrupted_render_removes_its_temporary_file(rig_dir, tmp_path):
         assert proc.returncode == 128 + sig
         assert err.splitlines() == [f"rigedit: interrupted by {signal.Signals(sig).name}"], err
         assert list(out.parent.iterdir()) == []   # no temporary file, no output
+
+
+def test_a_folder_that_refuses_the_temporary_file_is_reported_as_the_target(tmp_path,
+                                                                            monkeypatch):
+    import tempfile
+
+    from rigedit.io.atomic import write_json
+
+    def refuse(prefix="", suffix="", dir=None):
+        raise PermissionError(13, "Permission denied", f"{dir}/{prefix}abc{suffix}")
+
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    with pytest.raises(PermissionError) as info:
+        write_json(tmp_path / "x.json", {})
+    assert info.value.filename == str(tmp_path / "x.json")
+    assert "Permission denied" in str(info.value) and ".x.json." not in str(info.value)
