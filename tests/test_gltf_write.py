@@ -38,6 +38,8 @@ def _times(clip, fps=30.0):
 def assert_same_rig(a, b, tol=1e-6, skins=3):
     assert a.skeleton.names == b.skeleton.names
     assert np.array_equal(a.skeleton.parents, b.skeleton.parents)
+    assert np.array_equal(a.skeleton.deform, b.skeleton.deform)
+    np.testing.assert_allclose(a.skeleton.tails, b.skeleton.tails, atol=1e-12)
     assert _rel(a.vertices, b.vertices) < tol
     assert np.array_equal(a.faces, b.faces)
     assert _rel(a.binding.dense(), b.binding.dense()) < tol

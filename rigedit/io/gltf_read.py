@@ -206,7 +206,9 @@ def _build_skeleton(data, skin_index, parent):
                                dtype=np.float64)
     smap = SkeletonMap(ordered, [prefix[n] for n in ordered], joints)
     parents = [-1 if parent_of[n] is None else smap.of_node[parent_of[n]] for n in ordered]
-    deform = np.array([n in set(joints) for n in ordered])
+    deform = np.array([n in set(joints) and _own(nodes[n]).get("deform") is not False
+                       for n in ordered])
+    tails = np.array([_tail(nodes[n]) for n in ordered])
     rest = Skeleton([name_of[n] for n in ordered], parents, np.array(t), np.array(r),
                     np.array(s), deform=deform)
     ibm = _inverse_binds(data, skin_index, len(joints))
@@ -218,10 +220,25 @@ def _build_skeleton(data, skin_index, parent):
         raise RigFileError(data.path, f"skin {skin_index}: expected invertible inverse bind "
                                       "matrices, got a singular one") from None
     skeleton = Skeleton(rest.names, rest.parents, rest.rest_translation, rest.rest_rotation,
-                        rest.rest_scale, bind_matrices=bind, deform=deform)
+                        rest.rest_scale, bind_matrices=bind, tails=tails, deform=deform)
     # the file's inverse bind matrices as given, not inverted twice
     skeleton.inverse_bind_matrices = inverse
     return skeleton, smap
+
+
+def _own(node):
+    """rigedit's own extras of a node (written by rigedit's glTF export), or {}."""
+    own = node.extras.get("rigedit") if isinstance(node.extras, dict) else None
+    return own if isinstance(own, dict) else {}
+
+
+def _tail(node):
+    """(3,) a joint's bone tail from rigedit's extras, NaN when absent or malformed."""
+    try:
+        tail = np.asarray(_own(node).get("tail"), dtype=np.float64).reshape(3)
+    except (TypeError, ValueError):
+        return np.full(3, np.nan)
+    return tail if np.all(np.isfinite(tail)) else np.full(3, np.nan)
 
 
 def _inverse_binds(data, skin_index, count):

@@ -10,7 +10,8 @@ animation. Interpolation maps honestly: ``step`` -> STEP, ``linear``/``slerp`` -
 CUBICSPLINE, and ``nlerp``/``hybrid`` (which glTF cannot express) resampled: each key
 interval is cut into pieces of at most :data:`RESAMPLE_DEGREES` so that LINEAR (slerp) between
 the samples stays within about 1e-6 rad of the original curve. A clip's duration and loop flag
-go into the animation's ``extras`` and are read back by rigedit.
+go into the animation's ``extras``, a joint's tail and deform flag into its node's, and are
+read back by rigedit.
 
 The container is written here rather than through pygltflib because the writer needs exact
 control of padding and of which fields appear (the Khronos validator flags stray defaults).
@@ -198,6 +199,14 @@ def _nodes(w, rig):
             node["rotation"] = [float(x) for x in r / np.linalg.norm(r)]
         if np.any(s != 1):
             node["scale"] = [float(x) for x in s]
+        # what glTF has no field for, kept for rigedit: a bone's tail, a non-deforming joint
+        extras = {}
+        if np.all(np.isfinite(sk.tails[j])):
+            extras["tail"] = [float(x) for x in sk.tails[j]]
+        if not sk.deform[j]:
+            extras["deform"] = False
+        if extras:
+            node["extras"] = {"rigedit": extras}
         kids = sk.children(j)
         if len(kids):
             node["children"] = [first + int(c) for c in kids]
