@@ -362,3 +362,28 @@ def test_a_recovered_rig_given_the_original_record_deletes_a_deleted_clip(tmp_pa
     remember_clip_files(recovered, loaded_clip_files(rig))
     save_rig_folder(folder, recovered)
     assert list(load(folder).clips) == []
+
+
+def test_a_load_waits_for_a_save_in_progress_instead_of_undoing_it(tmp_path):
+    """Another process's save holds the folder's lock while it stages: a load meanwhile
+    must not take the staging folder for a crash's litter and delete it."""
+    import threading
+
+    from rigedit.io.rig_save import folder_lock
+
+    folder = tmp_path / "r"
+    save_rig_folder(folder, cylinder_rig())
+    stage = folder / STAGING
+    outcome = []
+    with folder_lock(folder):            # a save in progress (the lock is per open file)
+        stage.mkdir()
+        (stage / "skeleton.json").write_text("being written")
+        loader = threading.Thread(target=lambda: outcome.append(
+            recover_interrupted_save(folder)))
+        loader.start()
+        loader.join(0.3)
+        assert loader.is_alive() and stage.exists()   # waiting, staging untouched
+        stage.joinpath("skeleton.json").unlink()      # the save finishes and cleans up
+        stage.rmdir()
+    loader.join(10)
+    assert outcome == [None]

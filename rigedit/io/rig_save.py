@@ -18,24 +18,13 @@ finishes what a killed save left: a staging folder with a journal is applied aga
 idempotent (a file already moved is no longer staged), so the folder loads as the new state;
 one without a journal is deleted, so the folder loads as the old state.
 
-Which clip files are rigedit's
-------------------------------
-A save deletes from ``animations/`` only clip files that are rigedit's:
+A save holds an exclusive lock on the folder (``flock`` on the folder itself, released by the
+system when the process dies; none on Windows), and so does the recovery: a load that starts
+while another process saves waits for that save to finish instead of taking its half-written
+staging folder for the litter of a crash. (A save that starts while a load is already reading
+is not waited for.)
 
-- those the folder's ``rig.json`` lists under ``"clips"`` (``{name: "animations/FILE.json"}``,
-  written by every save), and
-- those the saved rig's clips were read from, when they are in this folder
-  (``load_rig_folder`` records them with :func:`remember_clip_files`).
-
-- a clip file it has no record of that holds a clip of a name being saved becomes that clip's
-  file (a document recovered after a crash, or saved over a folder it did not come from).
-
-A clip that is deleted or renamed in the editor is therefore gone after the save. Every other
-file is left as it is: a README, pictures, a clip file of another name someone copied in after
-the rig was loaded (it loads as one more clip next time). A second file holding a clip of a
-name being saved is an error (the folder would not load), named in the message, before
-anything is written. The rig's own files (``rig.json``, the mesh, ``skeleton.json``,
-``weights.npz``) are replaced.
+Which clip files a save replaces and deletes: :mod:`rigedit.io.clip_files`.
 """
 from __future__ import annotations
 
@@ -43,43 +32,41 @@ import contextlib
 import json
 import os
 import shutil
-import weakref
 from pathlib import Path, PurePosixPath
 
-from ..animation.clip_names import check_clip_name, clip_file_stem, name_key
+from ..animation.clip_names import check_clip_name
 from ..errors import RigFileError
 from .atomic import check_output_folder, fsync_folder, write_json
+from .clip_files import (ANIMATIONS, clip_entry, loaded_clip_files, plan_clip_files,
+                         remember_clip_files)
 from .clip_json import save_clip
 from .mesh import save_obj
 from .skeleton_json import save_skeleton
 from .weights_npz import save_weights
 
 __all__ = ["save_rig_folder_atomic", "recover_interrupted_save", "remember_clip_files",
-           "loaded_clip_files", "is_bundled", "STAGING", "JOURNAL"]
+           "loaded_clip_files", "is_bundled", "folder_lock", "STAGING", "JOURNAL"]
 
 #: The staging folder inside a rig folder, and the journal inside it.
 STAGING = ".rigedit-save"
 JOURNAL = "COMMIT"
-ANIMATIONS = "animations"
-
-# Rig -> {clip name: resolved path} of the files its clips were loaded from. Kept beside the
-# rig rather than in it: only saving needs it, and a rig built in code has none.
-_LOADED_FROM = weakref.WeakKeyDictionary()
 
 
-def remember_clip_files(rig, files):
-    """Record that ``rig``'s clips were read from ``files`` (``{clip name: path}``).
-
-    ``load_rig_folder`` calls it; code that rebuilds a rig from a copy of it (a recovery
-    snapshot) can pass on :func:`loaded_clip_files` of the original, so that a save over the
-    original folder still deletes the files of clips deleted since."""
-    _LOADED_FROM[rig] = {name: Path(p).resolve() for name, p in files.items()}
-
-
-def loaded_clip_files(rig):
-    """``{clip name: path}`` of the files ``rig``'s clips were read from (empty for a rig
-    built in code)."""
-    return dict(_LOADED_FROM.get(rig, {}))
+@contextlib.contextmanager
+def folder_lock(folder, shared=False):
+    """Hold an exclusive (or ``shared``) lock on ``folder`` for the block; waits for another
+    process's. Saves and recoveries take it exclusively. A no-op where ``flock`` is missing."""
+    try:
+        import fcntl
+        fd = os.open(folder, os.O_RDONLY)
+    except (ImportError, OSError):
+        yield
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH if shared else fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)   # releases the lock
 
 
 def is_bundled(path):
@@ -91,104 +78,6 @@ def is_bundled(path):
     roots = {Path(rigedit.ASSETS_DIR).resolve(), package, package.parent / "assets"}
     path = Path(path).resolve()
     return any(path == root or root in path.parents for root in roots)
-
-
-# ---------------------------------------------------------------------- planning
-def _clip_entry(rel):
-    """``rel`` ("animations/NAME.json") as a file name inside ``animations/``, or None when it
-    is anything else (a save never deletes outside ``animations/``)."""
-    if not isinstance(rel, str):
-        return None
-    parts = PurePosixPath(rel).parts
-    if (len(parts) == 2 and parts[0] == ANIMATIONS and parts[1].endswith(".json")
-            and parts[1] not in (".", "..") and "\\" not in parts[1]):
-        return parts[1]
-    return None
-
-
-def _previous_manifest(folder):
-    try:
-        data = json.loads((folder / "rig.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return {}
-    return data if isinstance(data, dict) else {}
-
-
-def _declared_name(path):
-    """The clip name a JSON file declares, or None (unreadable, not a clip)."""
-    try:
-        if path.stat().st_size > 64 * 2**20:
-            return None
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    if isinstance(data, dict) and ("tracks" in data or "keyframes" in data):
-        return str(data.get("name") or path.stem)
-    return None
-
-
-def plan_clip_files(folder, rig, names):
-    """File names for the clips being saved, and the stale clip files to delete.
-
-    A clip keeps the file it was loaded from or last saved to (``rig.json``'s record). A clip
-    file rigedit has no record of that holds a clip of a name being saved is that clip's file
-    (a recovered or re-opened document saved over its folder) unless the clip already has
-    one. A new or renamed clip gets a file name derived from its name
-    (:func:`clip_file_stem`), never one that another file already has.
-
-    Returns
-    -------
-    files : dict[str, str]
-        Clip name -> file name inside ``animations/``.
-    stale : list[str]
-        File names inside ``animations/`` to delete.
-
-    Raises
-    ------
-    RigFileError
-        A file rigedit has no record of holds a clip of a name being saved that has its own
-        file already: the folder would hold that name twice.
-    """
-    anim = (folder / ANIMATIONS).resolve()
-    previous = {}   # clip name -> file name in animations/, for rigedit's files
-    recorded = _previous_manifest(folder).get("clips")
-    for name, rel in (recorded.items() if isinstance(recorded, dict) else ()):
-        file = _clip_entry(rel)
-        if file is not None:
-            previous.setdefault(name, file)
-    for name, path in _LOADED_FROM.get(rig, {}).items():
-        if path.parent == anim:
-            previous[name] = path.name
-    present = sorted(p.name for p in anim.iterdir()) if anim.is_dir() else []
-    on_disk = {name_key(f) for f in present}
-    ours = {name_key(f) for f in previous.values()}
-    for file in present:
-        if name_key(file) in ours or not file.endswith(".json"):
-            continue
-        declared = _declared_name(anim / file)
-        if declared not in names:
-            continue
-        if declared in previous and name_key(previous[declared]) in on_disk:
-            raise RigFileError(anim / file, f"holds a clip {declared!r}, and so does "
-                               f"{previous[declared]}, which this save writes: expected one "
-                               "file per clip name (move the file away or rename the clip)")
-        previous[declared] = file
-        ours.add(name_key(file))
-    used = {name_key(f) for f in present if name_key(f) not in ours}
-    files = {}
-    for name in names:   # first the clips that keep their file
-        file = previous.get(name)
-        if file is not None and name_key(file) not in used:
-            files[name] = file
-            used.add(name_key(file))
-    for name in names:
-        if name not in files:
-            files[name] = clip_file_stem(name, used) + ".json"
-            used.add(name_key(files[name]))
-    kept = {name_key(f) for f in files.values()}
-    stale = sorted(f for f in present if name_key(f) in ours and name_key(f) not in kept
-                   and f.endswith(".json"))
-    return files, stale
 
 
 # ---------------------------------------------------------------------- saving
@@ -228,7 +117,12 @@ def save_rig_folder_atomic(folder, rig, mesh_name="mesh.obj", allow_bundled=Fals
         raise ValueError(f"expected distinct clip names, got {sorted(names)}")
     check_output_folder(folder)
     folder.mkdir(exist_ok=True)
-    recover_interrupted_save(folder)
+    with folder_lock(folder):
+        _recover(folder)
+        return _save(folder, rig, names, mesh_name)
+
+
+def _save(folder, rig, names, mesh_name):
     files, stale = plan_clip_files(folder, rig, names)
 
     stage = folder / STAGING
@@ -300,10 +194,10 @@ def _read_journal(path):
           and isinstance(journal.get("delete"), list))
     if ok:
         for rel in journal["replace"]:
-            ok = ok and (_clip_entry(rel) is not None or (
+            ok = ok and (clip_entry(rel) is not None or (
                 isinstance(rel, str) and PurePosixPath(rel).name == rel
                 and rel not in ("", ".", "..", STAGING) and "\\" not in rel))
-        ok = ok and all(_clip_entry(rel) is not None for rel in journal["delete"])
+        ok = ok and all(clip_entry(rel) is not None for rel in journal["delete"])
         ok = ok and not set(journal["replace"]) & set(journal["delete"])
     if not ok:
         raise RigFileError(path, "expected a save journal listing files of the rig folder "
@@ -328,7 +222,15 @@ def recover_interrupted_save(folder):
     folder = Path(folder)
     stage = folder / STAGING
     if not (stage.exists() or stage.is_symlink()):
-        return None
+        return None   # the common case, without a lock
+    with folder_lock(folder):
+        return _recover(folder)
+
+
+def _recover(folder):
+    stage = folder / STAGING
+    if not (stage.exists() or stage.is_symlink()):
+        return None   # a save in progress meanwhile finished
     try:
         if not (stage / JOURNAL).is_file():
             _remove_tree(stage)
