@@ -7,7 +7,7 @@ Layout::
     $XDG_CACHE_HOME/rigedit/            (~/.cache/rigedit when XDG_CACHE_HOME is unset)
       rigedit.log                       the editor's error log (tracebacks)
       recovery/
-        <pid>-<start>/                  one entry per running editor process
+        <pid>-<start>[-<window>]/       one entry per editor (window) running
           <n>/                          one snapshot, n counting up; the highest complete
             rig/                        one wins (a crash while writing n+1 leaves n)
             recovery.json               written last: a snapshot without it is incomplete
@@ -79,10 +79,12 @@ def process_alive(pid, start=None):
     return start is None or now is None or now == start
 
 
-def entry_folder(pid=None):
-    """The recovery entry folder of process ``pid`` (this process by default)."""
+def entry_folder(pid=None, window=None):
+    """The recovery entry folder of process ``pid`` (this process by default), and of its
+    editor window number ``window`` when a process runs several."""
     pid = os.getpid() if pid is None else int(pid)
-    return recovery_dir() / f"{pid}-{process_start(pid) or 0}"
+    name = f"{pid}-{process_start(pid) or 0}"
+    return recovery_dir() / (name if window is None else f"{name}-{int(window)}")
 
 
 def is_bundled(path):
@@ -179,7 +181,7 @@ def write_entry(rig, pose, clip=None, time=0.0, original_path=None, folder=None)
         raise ValueError(f"expected a pose of {len(rig.skeleton)} joints, got {pose.shape}")
     snap.mkdir()
     save_rig_folder(snap / "rig", rig)
-    pid_text, _, start_text = folder.name.partition("-")
+    pid_text, start_text = (folder.name.split("-") + [""])[:2]
     write_json(snap / _INFO, {
         "format": FORMAT, "version": 1,
         "pid": int(pid_text) if pid_text.isdigit() else os.getpid(),

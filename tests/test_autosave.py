@@ -90,6 +90,19 @@ def test_clean_close_leaves_nothing(make_editor, cache):
     assert _entries() == [] and not w.autosave.folder.exists()
 
 
+def test_each_window_has_its_own_entry(make_editor):
+    a, b = make_editor(), make_editor()
+    a.document.set_joint_euler(3, [0, 0, 25])
+    b.document.set_joint_euler(4, [0, 0, -25])
+    assert a.autosave.save() and b.autosave.save()
+    assert a.autosave.folder != b.autosave.folder and len(_entries()) == 2
+    a.close()
+    assert [e.folder for e in _entries()] == [b.autosave.folder]
+    assert not b.autosave.crash_save()  # the entry already holds its last edit
+    b.document.set_joint_euler(4, [0, 0, -30])
+    assert b.autosave.crash_save() and b.autosave.writes == 2
+
+
 def _stale_entry(rig, pose, clip, t, original):
     """An entry as left by an editor process that no longer runs."""
     from rigedit import recovery

@@ -52,10 +52,13 @@ class Autosave(QtCore.QObject):
         Snapshots written so far.
     """
 
+    _windows = 0
+
     def __init__(self, window, interval=None):
         super().__init__(window)
         self.window = window
-        self.folder = recovery.entry_folder()
+        Autosave._windows += 1  # each window of a process has its own entry
+        self.folder = recovery.entry_folder(window=Autosave._windows)
         self.writes = 0
         self._written = None  # undo-stack revision of the last snapshot
         self.timer = QtCore.QTimer(self)
@@ -101,9 +104,11 @@ class Autosave(QtCore.QObject):
         return True
 
     def crash_save(self):
-        """Save for recovery after an unexpected error or on a signal; never raises."""
-        try:
-            return self.save(force=True)
+        """Save for recovery after an unexpected error or on a signal, unless the entry
+        already holds the last edit (a callback failing at each mouse move must not write
+        each time); never raises."""
+        try:  # the state of the last edit (a half-done drag is not work to keep)
+            return self.save()
         except Exception:  # noqa: BLE001 - called while handling a failure already
             errors_hook.logger().error("recovery save failed", exc_info=True)
             return False
