@@ -119,3 +119,19 @@ def test_cli_export_bvh_and_atomicity(tmp_path, capsys, monkeypatch):
         save_bvh(rig, out)
     assert out.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["walk.bvh"]
+
+
+def test_meshless_rig_folder_round_trip(tmp_path):
+    """A BVH rig saved as a rig folder has no mesh or weights file and opens again."""
+    rig = load_bvh(shared(FILES[1]), scale=0.01)
+    folder = tmp_path / "walk"
+    rig.save(folder)
+    assert not (folder / "mesh.obj").exists() and not (folder / "weights.npz").exists()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")   # no "weights computed" warning: there is no mesh
+        back = rigedit.load_rig(folder)
+    assert back.vertices.shape == (0, 3) and back.faces.shape == (0, 3)
+    clip = rig.clips["take"]
+    times = bvh_frame_times(clip)[0]
+    np.testing.assert_allclose(positions_per_frame(back, back.clips["take"], times),
+                               positions_per_frame(rig, clip, times), atol=1e-6)

@@ -56,12 +56,12 @@ def find_rig_files(folder):
     manifest = read_json(folder / "rig.json") if (folder / "rig.json").is_file() else {}
     if not isinstance(manifest, dict):
         raise RigFileError(folder / "rig.json", "expected a JSON object")
-    if "mesh" in manifest:
-        meshes = [folder / manifest["mesh"]]
+    if "mesh" in manifest:   # "mesh": null is a rig without a mesh (a BVH skeleton)
+        meshes = [] if manifest["mesh"] is None else [folder / manifest["mesh"]]
     else:
         meshes = _meshes_in(folder) or (
             _meshes_in(folder / "models") if (folder / "models").is_dir() else [])
-    if not meshes:
+    if not meshes and "mesh" not in manifest:
         raise RigFileError(folder, f"expected a mesh file ({', '.join(MESH_SUFFIXES)}) in the "
                                    "folder or in models/, got none")
     if "skeleton" in manifest:
@@ -93,6 +93,8 @@ def load_rig_folder(folder, weights_method="idw"):
     skeleton, meta = load_skeleton(files["skeleton"])
 
     def read_mesh(weld):
+        if not files["meshes"]:
+            return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
         parts = [load_mesh(p, weld=weld) for p in files["meshes"]]
         offsets = np.cumsum([0] + [len(v) for v, _ in parts[:-1]])
         return (np.concatenate([v for v, _ in parts]),
@@ -107,6 +109,8 @@ def load_rig_folder(folder, weights_method="idw"):
         if weights_vertex_count(files["weights"]) != len(vertices):
             vertices, faces = read_mesh(weld=True)
         indices, weights = load_weights(files["weights"], skeleton, len(vertices))
+    elif not files["meshes"]:
+        indices, weights = np.zeros((0, 1), dtype=np.int64), np.zeros((0, 1))
     else:
         vertices, faces = read_mesh(weld=True)
         warnings.warn(f"{folder}: no weights file; computed weights by inverse distance to "

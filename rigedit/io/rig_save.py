@@ -129,21 +129,28 @@ def _save(folder, rig, names, mesh_name):
     _remove_tree(stage)
     try:
         (stage / ANIMATIONS).mkdir(parents=True)
-        save_obj(stage / mesh_name, rig.vertices, rig.faces, header=f"rigedit rig {rig.name}")
+        # a rig without a mesh (a BVH skeleton) has no mesh or weights file: "mesh": null
+        meshless = len(rig.vertices) == 0
+        if not meshless:
+            save_obj(stage / mesh_name, rig.vertices, rig.faces,
+                     header=f"rigedit rig {rig.name}")
+            save_weights(stage / "weights.npz", rig.binding.indices, rig.binding.weights,
+                         rig.skeleton.names)
         save_skeleton(stage / "skeleton.json", rig.skeleton, up=rig.up)
-        save_weights(stage / "weights.npz", rig.binding.indices, rig.binding.weights,
-                     rig.skeleton.names)
         for clip in rig.clips.values():
             save_clip(stage / ANIMATIONS / files[clip.name], clip)
         clip_paths = {name: f"{ANIMATIONS}/{files[name]}" for name in sorted(files)}
-        write_json(stage / "rig.json", {"name": rig.name, "mesh": mesh_name,
-                                        "skeleton": "skeleton.json", "weights": "weights.npz",
-                                        "up": rig.up, "clips": clip_paths})
+        manifest = {"name": rig.name, "mesh": None if meshless else mesh_name,
+                    "skeleton": "skeleton.json", "weights": "weights.npz", "up": rig.up,
+                    "clips": clip_paths}
+        if meshless:
+            del manifest["weights"]
+        write_json(stage / "rig.json", manifest)
         fsync_folder(stage / ANIMATIONS)
         fsync_folder(stage)
         journal = {"format": "rigedit.save-journal", "version": 1,
-                   "replace": [mesh_name, "skeleton.json", "weights.npz",
-                               *clip_paths.values(), "rig.json"],
+                   "replace": [*([] if meshless else [mesh_name, "weights.npz"]),
+                               "skeleton.json", *clip_paths.values(), "rig.json"],
                    "delete": [f"{ANIMATIONS}/{f}" for f in stale]}
         write_json(stage / JOURNAL, journal)   # the commit point
     except BaseException:
