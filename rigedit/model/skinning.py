@@ -151,9 +151,13 @@ class SkinBinding:
         self._blend = np.empty((v, 12), dtype=np.float32)
         self._out = np.empty((v, 3), dtype=np.float32)
         self._tmp = np.empty((v, 3), dtype=np.float32)
-        # The kernels' inputs: C-contiguous float32 / int32, the exact compiled signature.
-        self._indices32 = np.ascontiguousarray(self.indices, dtype=np.int32)
-        self._weights32 = np.ascontiguousarray(self.weights, dtype=np.float32)
+        # The kernels' inputs: C-contiguous float32 / int32 (the exact compiled signature),
+        # each vertex's influences sorted by decreasing weight (the kernels stop at a zero).
+        order = np.argsort(-self.weights, axis=1, kind="stable")
+        self._indices32 = np.ascontiguousarray(np.take_along_axis(self.indices, order, 1),
+                                               dtype=np.int32)
+        self._weights32 = np.ascontiguousarray(np.take_along_axis(self.weights, order, 1),
+                                               dtype=np.float32)
         self._dq = np.empty((self.num_joints, 8), dtype=np.float32)
         self._scale = np.empty((self.num_joints, 9), dtype=np.float32)
         self._rest_normals32 = None  # set by bind_normals
