@@ -124,8 +124,8 @@ def test_unexpected_exception_in_a_worker_is_logged_not_printed(editor, cache, q
 
     editor.run_job("Crunching", work, lambda r: None)
     qtbot.waitUntil(lambda: editor.job is None, timeout=10000)
-    assert "unexpected ZeroDivisionError" in editor.last_error
-    assert "details in the log" in editor.last_error
+    shown = editor.error_display.label.text()
+    assert "Crunching failed: ZeroDivisionError: division by zero" in shown
+    assert "(in jobs.py:" in shown and "Traceback" not in shown  # innermost rigedit frame
     assert "1 / 0" in _log(cache)
     assert "Traceback" not in capfd.readouterr().err
-    editor._last_dialog.close()

@@ -15,8 +15,9 @@ from ui_window_fixture import limb_joint  # noqa: E402
 
 @pytest.fixture
 def gate(monkeypatch):
-    """Holds every re-bind open until ``gate.set()`` (cancel still works meanwhile)."""
-    from rigedit.ui import drag
+    """Holds every re-bind and weights job open until ``gate.set()`` (cancel still works
+    meanwhile)."""
+    from rigedit.ui import drag, file_actions
 
     event = threading.Event()
     real = drag.weights_in_chunks
@@ -27,6 +28,7 @@ def gate(monkeypatch):
         return real(vertices, skeleton, report=report, **kw)
 
     monkeypatch.setattr(drag, "weights_in_chunks", slow)
+    monkeypatch.setattr(file_actions, "weights_in_chunks", slow)
     yield event
     event.set()
 
@@ -185,3 +187,21 @@ def test_result_for_a_replaced_skeleton_is_dropped(window, qtbot, gate):
     _assert_state(doc, moved)  # the second result, computed for the old skeleton, is dropped
     assert "skeleton or the weights changed" in window.statusBar().currentMessage()
     window.set_mode("pose")
+
+
+def test_recomputed_weights_for_an_undone_skeleton_are_dropped(window, qtbot, gate):
+    from rigedit.document import skeleton_with_moved_joint
+
+    doc = window.document
+    j = limb_joint(doc.skeleton)
+    before = doc.rest_state()
+    moved = skeleton_with_moved_joint(doc.skeleton, j, doc.skeleton.bind_matrices[j, :3, 3] + 0.05)
+    doc.push_rest_edit("Move (rest)", before, (moved, before[1], before[2]))
+    assert window.files.recompute_weights() is not None
+    window.undo_action.trigger()  # the rest move goes while the weights are computed for it
+    assert doc.skeleton is before[0]
+    gate.set()
+    qtbot.waitUntil(lambda: window.job is None, timeout=30000)
+    _assert_state(doc, before)
+    assert "dropped: the skeleton changed" in window.statusBar().currentMessage()
+    assert not doc.undo_stack.can_undo and doc.undo_stack.can_redo

@@ -37,6 +37,16 @@ def _load_folder(path):
         return load_rig_folder(path)
 
 
+def _load_file(path):
+    """A glTF/GLB or BVH file as a rig; what the reader decided (a BVH's unit guess) is in
+    ``rig.notes`` for the status bar, so its warning is not needed here."""
+    import rigedit
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return rigedit.load_rig(path)
+
+
 class FileActions:
     """File operations of a :class:`MainWindow` (kept apart to keep the window small)."""
 
@@ -89,10 +99,20 @@ class FileActions:
 
         return self.w.run_job(f"Opening {Path(mesh_path).name}", work, self._opened)
 
+    def open_file(self, path=None):
+        """Open a glTF/GLB file or a BVH file (a skeleton and its motion, no mesh)."""
+        path = path or self._ask_open("Open glTF or BVH file",
+                                      "Rigs and motion (*.glb *.gltf *.bvh)")
+        if not path:
+            return None
+        return self.w.run_job(f"Opening {Path(path).name}", lambda report: _load_file(path),
+                              self._opened)
+
     def _opened(self, rig):
         self.doc.set_rig(rig)
+        notes = "".join(f"; {key}: {value}" for key, value in sorted(rig.notes.items()))
         self.w.status(f"Opened {rig.name}: {len(rig.vertices):,} vertices, "
-                      f"{len(rig.skeleton)} joints, {len(rig.clips)} clips")
+                      f"{len(rig.skeleton)} joints, {len(rig.clips)} clips{notes}")
 
     # ------------------------------------------------------------------ save
     def save(self):
@@ -155,6 +175,21 @@ class FileActions:
             "Export skeleton", lambda: save_skeleton(path, self.doc.skeleton, up=self.doc.rig.up),
             f"Exported the skeleton to {path}")
 
+    def export(self, path=None):
+        """Export the rig as glTF (.glb/.gltf, every clip) or BVH (the skeleton and the
+        current clip); the format follows the extension."""
+        rig, clip = self.doc.rig, self.doc.current_clip
+        path = path or self._ask_save("Export", f"{rig.name}.glb",
+                                      "glTF binary (*.glb);;glTF (*.gltf);;BVH (*.bvh)")
+        if not path:
+            return False
+        from ..io.save import save_rig
+
+        bvh = Path(path).suffix.lower() == ".bvh"
+        clips = [clip] if bvh and clip is not None else None
+        return self._attempt("Export", lambda: save_rig(rig, path, clips=clips),
+                             f"Exported {rig.name} to {path}")
+
     # ------------------------------------------------------------------ weights
     def load_weights(self, path=None):
         """Replace the skin weights from a .npz file (one undo step)."""
@@ -183,8 +218,14 @@ class FileActions:
         vertices, skeleton = rig.vertices, rig.skeleton
 
         def done(result):
-            if self.doc.rig is not rig:
-                return  # another rig was opened meanwhile
+            if self.doc.rig is not rig or self.doc.skeleton is not skeleton:
+                # Weights for another rig or skeleton (opened, or a rest edit undone or
+                # redone meanwhile) must not be applied to this one.
+                what = "another rig was opened" if self.doc.rig is not rig else \
+                    "the skeleton changed"
+                self.w.status(f"Recomputed weights dropped: {what} while they were "
+                              f"computed; recompute them again")
+                return
             self.doc.set_weights(*result, label="Recompute weights")
             self.w.status(f"Recomputed weights for {len(vertices):,} vertices")
 

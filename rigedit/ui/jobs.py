@@ -26,7 +26,8 @@ class Job(QtCore.QThread):
     -------
     progress(int)      percent done, 0-100 (-1 when the job cannot tell)
     succeeded(object)  the function's result
-    failed(str)        one-line error message (ValueError and RigFileError keep their text)
+    failed(str)        one-line error message (ValueError and RigFileError keep their text);
+                       ``unexpected`` is then true when it was a bug, not bad input
     cancelled()
     """
 
@@ -40,6 +41,7 @@ class Job(QtCore.QThread):
         self.label = label
         self.fn = fn
         self._cancel = threading.Event()
+        self.unexpected = False
 
     def cancel(self):
         self._cancel.set()
@@ -67,7 +69,8 @@ class Job(QtCore.QThread):
 
             summary = describe(type(exc), exc, exc.__traceback__)
             logger().error("%s failed: %s", self.label, summary, exc_info=True)
-            self.failed.emit(f"unexpected {summary}; details in the log")
+            self.unexpected = True
+            self.failed.emit(summary)
         else:
             self.succeeded.emit(result)
 
@@ -118,7 +121,11 @@ class JobsMixin:
             finish()
             if on_cancel:
                 on_cancel()
-            self.error(label, msg)  # after on_cancel, so its status does not hide the error
+            # after on_cancel, so that its status does not hide the error
+            if job.unexpected:  # a bug: logged by the job, shown as one
+                self.show_unexpected_error(label, msg)
+            else:
+                self.error(label, msg)
 
         def cancelled():
             finish()
