@@ -127,3 +127,28 @@ def test_record_video_of_a_skeleton(bvh_window, tmp_path):
     frames = imageio.mimread(out)
     assert n == len(frames) == 6
     assert np.abs(frames[0].astype(int) - frames[3].astype(int)).max() > 50
+
+
+def test_file_open_bvh_and_export_bvh(bvh_window, qtbot, tmp_path):
+    w = bvh_window
+    src = tmp_path / "other.bvh"
+    src.write_text(BVH.replace("OFFSET 0 40 0", "OFFSET 0 30 0"))
+    w.files.open_file(str(src))
+    qtbot.waitUntil(lambda: w.document.rig.name == "other", timeout=10000)
+    rig = w.document.rig
+    assert "units: guessed centimetres" in w.statusBar().currentMessage()
+    assert len(w.gizmos.widgets) == 5 and w.scene.mesh_actor is None
+    out = tmp_path / "out.bvh"
+    assert w.files.export(str(out))
+    back = load_bvh(out, scale=0.01)
+    clip, back_clip = rig.clips["take"], back.clips["take"]
+    for t in (0.0, 0.5, 1.0):
+        np.testing.assert_allclose(back.joint_matrices(back_clip.sample(t))[:, :3, 3],
+                                   rig.joint_matrices(clip.sample(t))[:, :3, 3], atol=1e-7)
+    # a broken file: one message, the current rig stays
+    bad = tmp_path / "bad.bvh"
+    bad.write_text(BVH.replace("MOTION", "MOTIONLESS"))
+    w.files.open_file(str(bad))
+    qtbot.waitUntil(lambda: w.last_error is not None, timeout=10000)
+    assert "bad.bvh" in str(w.last_error) and "MOTION" in str(w.last_error)
+    assert w.document.rig is rig
