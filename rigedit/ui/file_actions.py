@@ -218,8 +218,14 @@ class FileActions:
         vertices, skeleton = rig.vertices, rig.skeleton
 
         def done(result):
-            if self.doc.rig is not rig:
-                return  # another rig was opened meanwhile
+            if self.doc.rig is not rig or self.doc.skeleton is not skeleton:
+                # Weights for another rig or skeleton (opened, or a rest edit undone or
+                # redone meanwhile) must not be applied to this one.
+                what = "another rig was opened" if self.doc.rig is not rig else \
+                    "the skeleton changed"
+                self.w.status(f"Recomputed weights dropped: {what} while they were "
+                              f"computed; recompute them again")
+                return
             self.doc.set_weights(*result, label="Recompute weights")
             self.w.status(f"Recomputed weights for {len(vertices):,} vertices")
 
