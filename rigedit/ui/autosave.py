@@ -63,6 +63,7 @@ class Autosave(QtCore.QObject):
         self._written = None  # undo-stack revision of the last snapshot
         self.timer = QtCore.QTimer(self)
         self.timer.timeout.connect(self.tick)
+        window.document.subscribe(self._on_document)
         self.set_interval(_interval_from_env() if interval is None else interval)
 
     def set_interval(self, seconds):
@@ -74,6 +75,11 @@ class Autosave(QtCore.QObject):
     @property
     def document(self):
         return self.window.document
+
+    def _on_document(self, event, **info):
+        # Saved, or undone back to the saved state: nothing to recover any more.
+        if event == "undo" and not self.document.modified and self.folder.exists():
+            self.discard()
 
     def tick(self):
         """The timer's check: write when the document changed; wait while a drag is under
