@@ -104,12 +104,19 @@ def guess_unit(size):
     return name, UNITS[name]
 
 
-def _axis_angle_quats(axis, degrees):
-    """(N, 4) quaternions (x, y, z, w) of rotations by ``degrees`` about axis 0, 1 or 2."""
-    half = np.radians(degrees) * 0.5
-    q = np.zeros((len(half), 4))
-    q[:, axis] = np.sin(half)
-    q[:, 3] = np.cos(half)
+def _axis_quats(axis, sin_half, cos_half):
+    """(N, 4) quaternions (x, y, z, w) of rotations about axis 0, 1 or 2, from the sine and
+    cosine of the half angles."""
+    q = np.zeros((len(sin_half), 4))
+    q[:, axis] = sin_half
+    q[:, 3] = cos_half
+    return q
+
+
+def _compose(sin_half, cos_half, axes):
+    q = _axis_quats(axes[0], sin_half[:, 0], cos_half[:, 0])
+    for k in range(1, len(axes)):
+        q = quat_multiply(q, _axis_quats(axes[k], sin_half[:, k], cos_half[:, k]))
     return q
 
 
@@ -135,34 +142,29 @@ def euler_channels_to_quats(angles, axes):
     budget of a BVH load; this is one vectorised product per channel
     (:func:`rigedit.model.transforms.quat_multiply`).
     """
-    angles = np.asarray(angles, dtype=np.float64)
-    q = _axis_angle_quats(axes[0], angles[:, 0])
-    for k in range(1, len(axes)):
-        q = quat_multiply(q, _axis_angle_quats(axes[k], angles[:, k]))
-    return q
-
-
-def _euler_quats(frames, channels, col):
-    """(N, 4) quaternions of one joint's rotation channels (columns from ``col``)."""
-    rot = [(axis, col + k) for k, (kind, axis) in enumerate(channels) if kind == "rotation"]
-    return euler_channels_to_quats(frames[:, [c for _, c in rot]], [axis for axis, _ in rot])
+    half = np.radians(np.asarray(angles, dtype=np.float64)) * 0.5
+    return _compose(np.sin(half), np.cos(half), list(axes))
 
 
 def _channel_values(data):
     """Per-joint rotation quaternions (N, 4) and local translations (N, 3) in file units:
     ``{joint index: array}`` for the joints that have such channels."""
     frames, offsets = data["frames"], data["offsets"]
+    # the sines and cosines of every channel's half angle in two calls, not one per joint
+    half = np.radians(frames) * 0.5
+    sin_half, cos_half = np.sin(half), np.cos(half)
     rotations, translations = {}, {}
     col = 0
     for j, channels in enumerate(data["channels"]):
-        kinds = [kind for kind, _ in channels]
-        if "rotation" in kinds:
-            rotations[j] = _euler_quats(frames, channels, col)
-        if "position" in kinds:
+        rot = [(axis, col + k) for k, (kind, axis) in enumerate(channels) if kind == "rotation"]
+        if rot:
+            cols = [c for _, c in rot]
+            rotations[j] = _compose(sin_half[:, cols], cos_half[:, cols], [a for a, _ in rot])
+        pos = [(axis, col + k) for k, (kind, axis) in enumerate(channels) if kind == "position"]
+        if pos:
             values = np.repeat(offsets[j][None], len(frames), axis=0)
-            for k, (kind, axis) in enumerate(channels):
-                if kind == "position":  # replaces the OFFSET component (module notes)
-                    values[:, axis] = frames[:, col + k]
+            for axis, c in pos:  # replaces the OFFSET component (module notes)
+                values[:, axis] = frames[:, c]
             translations[j] = values
         col += len(channels)
     return rotations, translations
