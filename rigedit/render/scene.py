@@ -133,7 +133,9 @@ class RigScene:
     def _add_bare_skeleton(self, plotter):
         """Joint balls and End-Site tail segments: what a mesh-less rig shows."""
         model = self.rig.skeleton.bind_matrices
-        self.joints = pv.PolyData(model[:, :3, 3].copy())
+        # no ball for a root that only carries the figure (it stays on the floor)
+        self._balls = np.flatnonzero(self.rig.skeleton.deform)
+        self.joints = pv.PolyData(model[self._balls, :3, 3].copy())
         self.joint_actor = plotter.add_mesh(self.joints, color=BONE_COLOR, point_size=11,
                                             render_points_as_spheres=True, name="rig-joints",
                                             reset_camera=False)
@@ -147,7 +149,7 @@ class RigScene:
                              reset_camera=False)
 
     def _update_bare_skeleton(self, model):
-        self.joints.points[:] = model[:, :3, 3]
+        self.joints.points[:] = model[self._balls, :3, 3]
         self.joints.Modified()
         if self.tails is not None:
             joints, tails = self.rig.posed_tails(model)
