@@ -77,6 +77,12 @@ def ensure_venv(extra):
     subprocess.run([str(PY), "-m", "pip", "install", "-q", "--upgrade", "pip"], check=True)
     target = f".[{extra}]" if extra else "."
     subprocess.run([str(PY), "-m", "pip", "install", "-q", "-e", target], check=True, cwd=ROOT)
+    # Compile the skinning kernels now, once: numba caches them on disk, so the editor never
+    # compiles them itself (without the cache it would use numpy until a background compile
+    # ends). A failure only means the numpy path.
+    say("compiling the skinning kernels (once; cached on disk)")
+    subprocess.run([str(PY), "-c", "from rigedit.model import skinning_kernels as k; k.load()"],
+                   cwd=ROOT)
     stamp.touch()
 
 

@@ -20,7 +20,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 from threadpoolctl import threadpool_limits
 
-from rigedit.model import Pose, Skeleton, SkinBinding, local_to_model, skinning_matrices
+from rigedit.model import (Pose, Skeleton, SkinBinding, local_to_model, skinning_kernels,
+                           skinning_matrices)
 from rigedit.model.skinning import top_k_influences
 from rigedit.model.weights import compute_weights
 
@@ -50,6 +51,9 @@ def bandwidth_gbs(nbytes=400_000_000):
 
 
 def main():
+    # The editor's path: the compiled kernels once loaded (see bench_skinning.py for each path).
+    kernels = skinning_kernels.load()
+    print(f"skinning: {'compiled kernels' if kernels else 'numpy'}")
     rng = np.random.default_rng(0)
     sk = make_skeleton(rng)
     poses = [Pose(sk, rotation=Rotation.random(J, random_state=i).as_quat()) for i in range(8)]

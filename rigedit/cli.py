@@ -112,7 +112,8 @@ def cmd_render(args):
     try:
         n = record_clip(rig, clip, args.output, fps=args.fps, duration=args.duration,
                         size=size, angle=args.angle, view=args.view,
-                        show_skeleton=args.skeleton, progress=progress)
+                        show_skeleton=args.skeleton, progress=progress,
+                        skinning=args.skinning)
     finally:
         if bar is not None:
             bar.close()
@@ -172,6 +173,8 @@ def build_parser():
     s.add_argument("--view", choices=("front", "side", "back", "top"), default="front")
     s.add_argument("--size", default="1280x720", metavar="WxH")
     s.add_argument("--skeleton", action="store_true", help="draw the bones too")
+    s.add_argument("--skinning", choices=("lbs", "dqs"), default="lbs",
+                   help="linear blend (default) or dual-quaternion skinning")
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     _scale_option(s)
     s.set_defaults(func=cmd_render)

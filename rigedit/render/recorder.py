@@ -96,7 +96,7 @@ class _Writer:
 def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=0.0,
                 view="front", angle=0.0, camera=None, orbit=0.0, follow_root=True,
                 show_skeleton=False, multi_samples=0, quality=7, progress=None,
-                show_floor=True, preset="veryfast"):
+                show_floor=True, preset="veryfast", skinning="lbs"):
     """Render ``clip`` on ``rig`` off-screen into a video file.
 
     Parameters
@@ -130,6 +130,8 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         imageio-ffmpeg quality 0-10 for MP4.
     preset : str
         x264 preset; ``veryfast`` keeps the encoder from being the bottleneck.
+    skinning : {"lbs", "dqs"}
+        Linear blend or dual-quaternion skinning.
     progress : callable(done, total) -> bool, optional
         Called after each frame; returning False cancels (raises ``RecordingCancelled``).
 
@@ -170,7 +172,8 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         plotter.enable_anti_aliasing("msaa", multi_samples=multi_samples) if multi_samples \
             else plotter.disable_anti_aliasing()
         plotter.set_background("#eef1f4", top="#c5ccd6")
-        scene = RigScene(plotter, rig, show_skeleton=show_skeleton, show_floor=show_floor)
+        scene = RigScene(plotter, rig, show_skeleton=show_skeleton, show_floor=show_floor,
+                         skinning=skinning)
         _grid_floor(plotter)
         pose = rig.rest_pose()
         if camera is not None:
