@@ -58,6 +58,11 @@ def joint_points(rig, model):
     return np.vstack([model[:, :3, 3], rig.posed_tails(model)[1]])
 
 
+def _srgb(linear_rgba):
+    """(3,) display colour of a linear glTF base colour factor (gamma 2.2)."""
+    return np.clip(np.asarray(linear_rgba[:3], dtype=float), 0, 1) ** (1 / 2.2)
+
+
 def faces_to_vtk(faces):
     """(F, 3) triangles -> pyvista's flat ``[3, a, b, c, ...]`` cell array."""
     faces = np.asarray(faces, dtype=np.int64)
@@ -104,9 +109,11 @@ class RigScene:
             self._normals.ConsistencyOff()
             self._normals.AutoOrientNormalsOff()
             self._normals.ComputeCellNormalsOff()
-            self.mesh_actor = plotter.add_mesh(self._normals, color=MESH_COLOR,
-                                               smooth_shading=True, specular=0.25,
-                                               specular_power=20, name="rig-mesh")
+            look = self._surface_look()
+            self.mesh_actor = plotter.add_mesh(self._normals, smooth_shading=True,
+                                               specular=0.25, specular_power=20,
+                                               name="rig-mesh", **look)
+            self._texture = look.get("texture")
         sk = rig.skeleton
         # No line from a non-deforming root (a ground-level carrier) to its children: that
         # "bone" moves no skin and would cut through the body down to the floor.
@@ -132,10 +139,32 @@ class RigScene:
         self.view("front")
 
     # ------------------------------------------------------------------ actors
+    def _surface_look(self):
+        """``add_mesh`` colour/texture arguments from the rig's surface: the base colour
+        texture through the UVs where a material has one, else the first material's base
+        colour factor, else rigedit's clay colour."""
+        surf = getattr(self.rig, "surface", None)
+        if surf is None:
+            return {"color": MESH_COLOR}
+        m = surf.textured_material()
+        if m is not None:
+            # glTF's v runs down the image; VTK's t runs up, and pyvista puts row 0 on top
+            uv = surf.uvs
+            self.mesh.active_texture_coordinates = np.column_stack(
+                [uv[:, 0], 1.0 - uv[:, 1]]).astype(np.float32)
+            mat = surf.materials[m]
+            return {"texture": pv.Texture(mat.texture), "color": _srgb(mat.base_color)}
+        used = [int(i) for i in surf.primitive_material if i >= 0]
+        if used:
+            return {"color": _srgb(surf.materials[used[0]].base_color)}
+        return {"color": MESH_COLOR}
+
     def _add_bare_skeleton(self, plotter):
         """Joint balls and End-Site tail segments: what a mesh-less rig shows."""
         model = self.rig.skeleton.bind_matrices
-        self.joints = pv.PolyData(model[:, :3, 3].copy())
+        # no ball for a root that only carries the figure (it stays on the floor)
+        self._balls = np.flatnonzero(self.rig.skeleton.deform)
+        self.joints = pv.PolyData(model[self._balls, :3, 3].copy())
         self.joint_actor = plotter.add_mesh(self.joints, color=BONE_COLOR, point_size=11,
                                             render_points_as_spheres=True, name="rig-joints",
                                             reset_camera=False)
@@ -149,7 +178,7 @@ class RigScene:
                              reset_camera=False)
 
     def _update_bare_skeleton(self, model):
-        self.joints.points[:] = model[:, :3, 3]
+        self.joints.points[:] = model[self._balls, :3, 3]
         self.joints.Modified()
         if self.tails is not None:
             joints, tails = self.rig.posed_tails(model)
@@ -163,7 +192,9 @@ class RigScene:
         bind time when it has no clip."""
         rig = self.rig
         if self.has_mesh:
-            return rig.vertices[::max(1, len(rig.vertices) // 4000)]
+            # the skinned rest pose, not the bind-space vertices: a glTF mesh may be stored in
+            # a frame of its own (CesiumMan's is Z up) that only its joints place
+            return rig.skin(rig.rest_pose())[::max(1, len(rig.vertices) // 4000)]
         clip = next(iter(rig.clips.values()), None)
         if clip is None or not clip.tracks:
             return joint_points(rig, rig.skeleton.bind_matrices)
@@ -236,7 +267,11 @@ class RigScene:
         if weights is None:
             mapper.ScalarVisibilityOff()
             self.weights_shown = False
+            if self._texture is not None:
+                self.mesh_actor.SetTexture(self._texture)
             return
+        if self._texture is not None:  # the heat map alone, not tinted by the texture
+            self.mesh_actor.SetTexture(None)
         w = np.asarray(weights, dtype=np.float32).reshape(-1)
         if w.shape[0] != self.mesh.n_points:
             raise ValueError(f"expected {self.mesh.n_points} weights, got {w.shape[0]}")
