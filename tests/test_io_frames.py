@@ -158,3 +158,27 @@ def test_info_prints_the_frames_decision(tmp_path, capsys):
     assert main(["info", str(folder)]) == 0
     out = dict(line.split(": ", 1) for line in capsys.readouterr().out.splitlines())
     assert out["up"] == "y" and "converted by (x, y, z) -> (x, z, -y)" in out["frames"]
+
+
+def test_rigedit_folder_with_z_up_skeleton_converts_skeleton_and_clips(tmp_path):
+    """rigedit's own formats: rig.json says the skeleton is Z up over a Y-up mesh; skeleton
+    and clips are converted together and the rig plays as the Y-up original."""
+    from rigedit.io.clip_json import save_clip
+    from rigedit.io.mesh import save_obj
+    from rigedit.io.skeleton_json import save_skeleton
+
+    rig = _rig_with_everything()
+    R = axis_change("y", "z")
+    sk_z, clips_z = change_axes(rig.skeleton, rig.clips, R)
+    folder = tmp_path / "r"
+    (folder / "animations").mkdir(parents=True)
+    save_obj(folder / "mesh.obj", rig.vertices, rig.faces)
+    save_skeleton(folder / "skeleton.json", sk_z, up="z")
+    save_clip(folder / "animations" / "mix.json", clips_z["mix"])
+    (folder / "rig.json").write_text(json.dumps({"up": "y", "skeleton_up": "z"}))
+    back, frames_warnings = _load(folder)
+    assert len(frames_warnings) == 1 and "converted together" in back.notes["frames"]
+    assert back.up == "y"
+    for t in np.linspace(0, 1, 5):
+        np.testing.assert_allclose(back.joint_matrices(back.clips["mix"].sample(t)),
+                                   rig.joint_matrices(rig.clips["mix"].sample(t)), atol=1e-6)

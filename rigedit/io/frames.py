@@ -156,12 +156,16 @@ def resolve_folder_frames(path, skeleton, meta, vertices, manifest):
     Returns
     -------
     skeleton : Skeleton
-        In the mesh's frame.
+        In the mesh's frame (elk layout: its points moved), or as read when ``clip_change``
+        is not None.
     up : {"y", "z"}
         The rig's up axis (the mesh's).
     note : str or None
         What was decided (None when nothing needed deciding); also warned as
         :class:`FramesWarning` when the skeleton was converted.
+    clip_change : (3, 3) float or None
+        For rigedit's own skeleton format: the rotation to apply to the skeleton and its
+        clips together, with :func:`change_axes`, once the clips are loaded.
     """
     skeleton_up = manifest.get("skeleton_up", meta["up"])
     for key, value in (("up", manifest.get("up", "y")), ("skeleton_up", skeleton_up)):
@@ -185,10 +189,15 @@ def resolve_folder_frames(path, skeleton, meta, vertices, manifest):
         how = (f"guessed: {moved[0]:.0%} of the joints lie inside the mesh's box with the "
                f"skeleton converted, {as_is[0]:.0%} as written")
     else:
-        return skeleton, manifest.get("up", meta["up"]), None
+        return skeleton, manifest.get("up", meta["up"]), None, None
     if skeleton_up == up:
-        return skeleton, up, f"skeleton and mesh both {up.upper()} up ({how})"
+        return skeleton, up, f"skeleton and mesh both {up.upper()} up ({how})", None
     R = axis_change(skeleton_up, up)
+    if meta.get("format") != "elk":
+        note = (f"skeleton {skeleton_up.upper()} up, mesh {up.upper()} up ({how}): skeleton "
+                f"and clips converted together (rotation keys conjugated)")
+        warnings.warn(f"{path}: {note}", FramesWarning, stacklevel=3)
+        return skeleton, up, note, R
     try:
         skeleton = move_skeleton_points(skeleton, R)
     except ValueError as exc:
@@ -199,4 +208,4 @@ def resolve_folder_frames(path, skeleton, meta, vertices, manifest):
             f"elk project's viewer does ({how}; set \"up\" and \"skeleton_up\" in rig.json "
             f"to override)")
     warnings.warn(f"{path}: {note}", FramesWarning, stacklevel=3)
-    return skeleton, up, note
+    return skeleton, up, note, None

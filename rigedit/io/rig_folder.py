@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import RigFileError
 from ..rig import Rig
 from .clip_json import load_clip
-from .frames import resolve_folder_frames
+from .frames import change_axes, resolve_folder_frames
 from .jsonfile import read_json
 from .mesh import MESH_SUFFIXES, load_mesh
 from .rig_save import recover_interrupted_save, remember_clip_files, save_rig_folder_atomic
@@ -116,8 +116,8 @@ def load_rig_folder(folder, weights_method="idw"):
         warnings.warn(f"{folder}: no weights file; computed weights by inverse distance to "
                       f"the bones ({weights_method})", WeightsComputedWarning, stacklevel=2)
     # the elk layout's skeleton may be Z up over a Y-up mesh (rigedit/io/frames.py)
-    skeleton, up, frames_note = resolve_folder_frames(folder, skeleton, meta, vertices,
-                                                      files["manifest"])
+    skeleton, up, frames_note, clip_change = resolve_folder_frames(
+        folder, skeleton, meta, vertices, files["manifest"])
     clips, sources = {}, {}
     for path in files["animations"]:
         clip = load_clip(path, skeleton)
@@ -125,6 +125,8 @@ def load_rig_folder(folder, weights_method="idw"):
             raise RigFileError(path, f"expected one file per clip name, got clip "
                                      f"{clip.name!r} in both {sources[clip.name]} and {path}")
         clips[clip.name], sources[clip.name] = clip, path
+    if clip_change is not None:   # rigedit's formats: skeleton and clips change together
+        skeleton, clips = change_axes(skeleton, clips, clip_change)
     name = files["manifest"].get("name", folder.resolve().name)
     rig = Rig(skeleton, vertices, faces, indices, weights, clips, name=name, up=up,
               weights_method=weights_method, path=folder)
