@@ -16,9 +16,10 @@ from rigedit.model.transforms import euler_to_quat
 from rigedit.rig import Rig
 
 
-def _rig_with_everything():
+def _rig_with_everything(spline=True):
     """A bent cylinder whose skeleton has rest rotations and a rest scale, with rotation
-    (slerp, Catmull-Rom, cubic spline), translation and scale tracks."""
+    (slerp, Catmull-Rom, and a cubic spline unless ``spline`` is false), translation and
+    scale tracks."""
     base = chain_skeleton(3)
     rest_rot = euler_to_quat([[0, 0, 10], [5, 0, 0], [0, 20, 0]], degrees=True)
     sk = Skeleton(base.names, base.parents, base.rest_translation, rest_rot,
@@ -26,13 +27,15 @@ def _rig_with_everything():
     q = euler_to_quat([[0, 0, 0], [30, 0, 40], [-20, 10, 0]], degrees=True)
     tangents = np.zeros((3, 2, 4))
     tangents[1] = [[0.1, 0.0, 0.2, 0.0], [0.0, 0.3, 0.0, -0.1]]
-    clip = Clip("mix", sk, {
+    tracks = {
         ("j1", "rotation"): Track("rotation", [0, .5, 1], q, "slerp"),
         ("j2", "rotation"): Track("rotation", [0, .5, 1], q[::-1], "catmull_rom"),
-        ("j0", "rotation"): Track("rotation", [0, .5, 1], q, "cubic_spline", tangents),
         ("j0", "translation"): Track("translation", [0, 1], [[0, 0, 0], [0.3, 0.2, -0.1]]),
         ("j2", "scale"): Track("scale", [0, 1], [[1, 1, 1], [1.5, 0.7, 1.1]]),
-    })
+    }
+    if spline:
+        tracks[("j0", "rotation")] = Track("rotation", [0, .5, 1], q, "cubic_spline", tangents)
+    clip = Clip("mix", sk, tracks)
     v, f = cylinder()
     return Rig(sk, v, f, clips={"mix": clip})
 
@@ -167,7 +170,7 @@ def test_rigedit_folder_with_z_up_skeleton_converts_skeleton_and_clips(tmp_path)
     from rigedit.io.mesh import save_obj
     from rigedit.io.skeleton_json import save_skeleton
 
-    rig = _rig_with_everything()
+    rig = _rig_with_everything(spline=False)
     R = axis_change("y", "z")
     sk_z, clips_z = change_axes(rig.skeleton, rig.clips, R)
     folder = tmp_path / "r"
