@@ -245,3 +245,28 @@ def test_euler_channels_match_scipy_intrinsic(seq):
     got = euler_channels_to_quats(angles, ["XYZ".index(a) for a in seq])
     want = Rotation.from_euler(seq, angles, degrees=True)
     assert np.allclose((Rotation.from_quat(got).inv() * want).magnitude(), 0, atol=1e-12)
+
+
+def test_windows_line_ends_tabs_and_a_byte_order_mark(tmp_path):
+    text = "\ufeff" + SMALL.replace("\n", "\r\n").replace("  ", "\t")
+    path = tmp_path / "win.bvh"
+    path.write_bytes(text.encode("utf-8"))
+    rig = load_bvh(path, scale=0.01)
+    np.testing.assert_allclose(rig.joint_matrices(rig.clips["take"].sample(1.0))[:, :3, 3],
+                               [[.02, .1, 0], [-.98, .1, 0], [-1.48, .1, 0]], atol=1e-12)
+
+
+@pytest.mark.parametrize("argv,problem", [
+    (["info", "{bvh}", "--scale", "-1"], "expected a scale > 0"),
+    (["info", "{folder}", "--scale", "0.01"], "only with a .bvh file"),
+])
+def test_cli_scale_errors(tmp_path, capsys, argv, problem):
+    from rigedit.cli import main
+
+    bvh = write(tmp_path, SMALL)
+    folder = tmp_path / "folder"
+    folder.mkdir()
+    argv = [a.format(bvh=bvh, folder=folder) for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and problem in err[0]

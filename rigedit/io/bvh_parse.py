@@ -220,7 +220,7 @@ def parse_bvh(path, text=None):
     path = Path(path)
     if text is None:
         try:
-            text = path.read_text(encoding="utf-8", errors="replace")
+            text = path.read_text(encoding="utf-8-sig", errors="replace")
         except OSError as exc:
             raise RigFileError(path, f"expected a readable file, got {exc.strerror or exc}") \
                 from None
