@@ -152,3 +152,23 @@ def test_file_open_bvh_and_export_bvh(bvh_window, qtbot, tmp_path):
     qtbot.waitUntil(lambda: w.last_error is not None, timeout=10000)
     assert "bad.bvh" in str(w.last_error) and "MOTION" in str(w.last_error)
     assert w.document.rig is rig
+
+
+def test_edit_mode_moves_a_rest_joint_of_a_skeleton(bvh_window, qtbot):
+    """Bind mode on a rig without a mesh: the rest joint moves (nothing to re-weight), one
+    undo step."""
+    w = bvh_window
+    doc = w.document
+    sk0 = doc.skeleton
+    foot = sk0.joint_index("LeftFoot")
+    w.set_mode("edit")
+    start = w.gizmos.center(foot).copy()
+    target = start + np.array([0.05, 0.0, 0.0])
+    _fire_drag(w.gizmos.widgets[foot], target)
+    qtbot.waitUntil(lambda: w.job is None, timeout=30000)
+    assert doc.skeleton is not sk0
+    np.testing.assert_allclose(doc.skeleton.bind_matrices[foot, :3, 3], target, atol=1e-9)
+    assert doc.rig.binding.indices.shape[0] == 0
+    w.undo_action.trigger()
+    assert doc.skeleton is sk0
+    w.set_mode("pose")
