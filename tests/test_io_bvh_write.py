@@ -135,3 +135,20 @@ def test_meshless_rig_folder_round_trip(tmp_path):
     times = bvh_frame_times(clip)[0]
     np.testing.assert_allclose(positions_per_frame(back, back.clips["take"], times),
                                positions_per_frame(rig, clip, times), atol=1e-6)
+
+
+def test_source_rotation_orders_are_kept(tmp_path):
+    src = shared(FILES[0])   # CMU: Zrotation Yrotation Xrotation, some Zrotation Xrotation Y...
+    rig = load_bvh(src, scale=0.01)
+    source_lines = [line.split()[-3:] for line in src.read_text().splitlines()
+                    if "CHANNELS" in line]
+    out = tmp_path / "cmu.bvh"
+    rig.save(out)
+    written = [line.split()[-3:] for line in out.read_text().splitlines() if "CHANNELS" in line]
+    assert written == source_lines and len({tuple(x) for x in written}) == 2
+    save_bvh(rig, out, order="XYZ")
+    text = out.read_text().split("MOTION")[0]
+    assert text.count("Xrotation Yrotation Zrotation") == 31
+    back = load_bvh(out, scale=0.01)
+    clip = rig.clips["take"]
+    assert_same_motion(rig, clip, back, bvh_frame_times(clip)[0])

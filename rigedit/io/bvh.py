@@ -242,6 +242,15 @@ def load_bvh(path, scale=None):
               up="y", path=path)
     rig.notes = {"units": units_note,
                  "frames": "BVH read as Y up, +Z forward (its usual convention), axes kept"}
+    # each joint's rotation channel order, so that a BVH written back keeps it (bvh_write)
+    orders = {name: "".join("XYZ"[axis] for kind, axis in channels if kind == "rotation")
+              for name, channels in zip(names, data["channels"])}
+    rig.source_rotation_orders = {n: o for n, o in orders.items() if sorted(o) == list("XYZ")}
+    counts = {}
+    for o in rig.source_rotation_orders.values():
+        counts[o] = counts.get(o, 0) + 1
+    rig.notes["rotation_order"] = ", ".join(f"{o} ({n} joints)" for o, n in
+                                            sorted(counts.items(), key=lambda c: -c[1])) or "-"
     return rig
 
 

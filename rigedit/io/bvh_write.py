@@ -112,7 +112,7 @@ def _bvh_names(names):
     return out
 
 
-def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order="ZXY"):
+def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order=None):
     """Write ``rig``'s skeleton and one clip as a BVH file, atomically.
 
     Parameters
@@ -126,9 +126,10 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order="ZXY")
         Frame rate; the clip's key rate when its keys lie on a regular grid, else 30.
     units_per_metre : float
         File units per metre (100: centimetres).
-    order : str
-        Rotation channel order, three of ``XYZ`` (``ZXY`` writes ``Zrotation Xrotation
-        Yrotation``).
+    order : str, optional
+        Rotation channel order of every joint, three of ``XYZ`` (``ZXY`` writes ``Zrotation
+        Xrotation Yrotation``); by default each joint keeps the order of the BVH file the rig
+        was read from (``rig.source_rotation_orders``), others get ``ZXY``.
 
     Returns
     -------
@@ -141,10 +142,12 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order="ZXY")
         clip = rig.clips[clip]
     if clip is None and rig.clips:
         clip = next(iter(rig.clips.values()))
-    order = order.upper()
-    if sorted(order) != ["X", "Y", "Z"]:
-        raise ValueError(f"expected a rotation order of X, Y and Z, got {order!r}")
     sk = rig.skeleton
+    source = getattr(rig, "source_rotation_orders", {}) if order is None else {}
+    orders = [str(source.get(name, order or "ZXY")).upper() for name in sk.names]
+    for o in set(orders):
+        if sorted(o) != ["X", "Y", "Z"]:
+            raise ValueError(f"expected a rotation order of X, Y and Z, got {o!r}")
     times, dt = bvh_frame_times(clip, fps)
     local_rot, local_t, _, _ = _local_parts(_model_frames(rig, clip, times), sk.parents)
     rest_model = rig.joint_matrices(rig.rest_pose())
@@ -155,11 +158,13 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order="ZXY")
     order_dfs, children = _depth_first(sk.parents)
     names = _bvh_names(sk.names)
     s = float(units_per_metre)
+    euler = np.empty((len(times), len(sk), 3))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # gimbal lock: angles still reproduce R
-        euler = Rotation.from_matrix(local_rot.reshape(-1, 3, 3)).as_euler(
-            order, degrees=True).reshape(len(times), len(sk), 3)
-    rot_channels = " ".join(f"{a}rotation" for a in order)
+        for o in set(orders):   # one batched conversion per order
+            js = [j for j in range(len(sk)) if orders[j] == o]
+            euler[:, js] = Rotation.from_matrix(local_rot[:, js].reshape(-1, 3, 3)).as_euler(
+                o, degrees=True).reshape(len(times), len(js), 3)
     lines = ["HIERARCHY"]
     columns = []
 
@@ -167,7 +172,8 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order="ZXY")
         pad = "  " * depth
         kind = "ROOT" if sk.parents[j] < 0 else "JOINT"
         o = offsets[j] * s
-        chans = ("Xposition Yposition Zposition " if with_pos[j] else "") + rot_channels
+        chans = (("Xposition Yposition Zposition " if with_pos[j] else "")
+                 + " ".join(f"{a}rotation" for a in orders[j]))
         lines.extend([f"{pad}{kind} {names[j]}", f"{pad}{{",
                       f"{pad}  OFFSET {o[0]:.6f} {o[1]:.6f} {o[2]:.6f}",
                       f"{pad}  CHANNELS {6 if with_pos[j] else 3} {chans}"])
