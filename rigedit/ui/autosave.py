@@ -109,12 +109,19 @@ class Autosave(QtCore.QObject):
         self.writes += 1
         return True
 
+    @property
+    def holds_work(self):
+        """Whether the entry holds the document's unsaved changes up to the last edit."""
+        doc = self.document
+        return doc.modified and self._written == doc.undo_stack.revision
+
     def crash_save(self):
         """Save for recovery after an unexpected error or on a signal, unless the entry
         already holds the last edit (a callback failing at each mouse move must not write
-        each time); never raises."""
-        try:  # the state of the last edit (a half-done drag is not work to keep)
-            return self.save()
+        each time). Returns :attr:`holds_work`; never raises."""
+        try:
+            self.save()
+            return self.holds_work
         except Exception:  # noqa: BLE001 - called while handling a failure already
             errors_hook.logger().error("recovery save failed", exc_info=True)
             return False

@@ -126,6 +126,9 @@ class DragMixin:
 
         def done(result):
             self._pending_rebind = None
+            if job.is_cancelled:  # undo cancelled it after the result was on its way
+                cancelled()
+                return
             if d.rig is not rig or d.skeleton is not base_skeleton \
                     or d.rig.binding is not base_binding:
                 what = "another rig was opened" if d.rig is not rig else \
@@ -159,7 +162,7 @@ class DragMixin:
     def undo(self):
         """Edit > Undo: cancels a running re-bind when it is the latest edit, else undoes the
         document's last step."""
-        pending = getattr(self, "_pending_rebind", None)
+        pending = self._pending_rebind
         if pending is not None and pending[0] is self.job and \
                 self.document.undo_stack.top is pending[1]:
             self._pending_rebind = None

@@ -128,10 +128,13 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
         iren.EnableRenderOff()
 
         def on_render_request(_obj, _event):
-            if getattr(plotter, "_in_paint", True):  # inside paintGL: render for real
-                rw.Render()
-            else:
-                plotter.update()
+            try:
+                if getattr(plotter, "_in_paint", True):  # inside paintGL: render for real
+                    rw.Render()
+                else:
+                    plotter.update()
+            except Exception:  # noqa: BLE001 - VTK would print and swallow it
+                self.report_exception("Rendering the 3D view")
 
         iren.AddObserver("RenderEvent", on_render_request)
 
