@@ -252,3 +252,43 @@ def test_wrong_gltf_json_version(tmp_path):
     with pytest.raises(RigFileError, match="version 2.x"):
         load_gltf(path)
 
+
+
+def _paths(node, prefix=()):
+    """Every (path, value) of a JSON tree, leaves and containers alike."""
+    yield prefix, node
+    if isinstance(node, dict):
+        for k, v in node.items():
+            yield from _paths(v, prefix + (k,))
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            yield from _paths(v, prefix + (i,))
+
+
+def test_every_field_with_a_wrong_value_gives_rig_file_error_or_loads(tmp_path):
+    """Fuzz: each field of a small skinned file replaced by a value of another kind or out of
+    range; loading either works or raises one RigFileError naming the file, nothing else."""
+    import copy
+
+    builder, _ = two_bone(interpolation="CUBICSPLINE", sparse=True)
+    base = builder.doc
+    bad_values = ["x", -1, 2 ** 31, None, [], {}, 1.5, [float("nan")] * 3]
+    outcomes = {"loaded": 0, "refused": 0}
+    for path, _ in list(_paths(base))[1:]:
+        for bad in bad_values:
+            doc = copy.deepcopy(base)
+            target = doc
+            for key in path[:-1]:
+                target = target[key]
+            target[path[-1]] = bad
+            builder.doc = doc
+            out = builder.write(tmp_path / "f.glb")
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", GltfWarning)  # skipped parts are fine here
+                    load_gltf(out)
+                outcomes["loaded"] += 1
+            except RigFileError as exc:
+                assert str(out) in str(exc)
+                outcomes["refused"] += 1
+    assert outcomes["refused"] > 100 and outcomes["loaded"] > 10

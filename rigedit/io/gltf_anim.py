@@ -86,7 +86,7 @@ def _channel_track(data, anim_index, anim, channel, ci, prefix):
     sampler = samplers[s]
     path = channel.target.path
     interp = sampler.interpolation or "LINEAR"
-    if interp not in _MODES:
+    if not isinstance(interp, str) or interp not in _MODES:
         raise RigFileError(data.path, f"{where}: expected interpolation LINEAR, STEP or "
                                       f"CUBICSPLINE, got {interp!r}")
     times = data.accessor(sampler.input, f"{where} input")
@@ -132,6 +132,12 @@ def read_clips(data, skeleton, smap, warning):
             target = channel.target
             if target is None or target.node is None:
                 continue
+            nodes = len(data.gltf.nodes or [])
+            if not isinstance(target.node, int) or not 0 <= target.node < nodes \
+                    or not isinstance(target.path, str):
+                raise RigFileError(data.path, f"animation {a} channel {ci}: expected a target "
+                                              f"node below {nodes} and a path, got "
+                                              f"{target.node!r} and {target.path!r}")
             if target.path == "weights":
                 morph += 1
                 continue

@@ -169,6 +169,8 @@ def read_mesh(data, mesh_nodes, num_joints, warning):
         for p, prim in enumerate(meshes[m].primitives or []):
             where = f"mesh {m} primitive {p}"
             mode = TRIANGLES if prim.mode is None else prim.mode
+            if not isinstance(mode, int) or not 0 <= mode <= 6:
+                raise RigFileError(data.path, f"{where}: expected a mode 0..6, got {mode!r}")
             if mode not in (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN):
                 skipped.add(mode)
                 continue

@@ -62,6 +62,9 @@ def _node_parents(data):
     nodes = data.gltf.nodes or []
     parent = np.full(len(nodes), -1, dtype=np.int64)
     for i, node in enumerate(nodes):
+        if not isinstance(node.children or [], list):
+            raise RigFileError(data.path, f"node {i}: expected 'children' to be a list, got "
+                                          f"{node.children!r}")
         for c in node.children or []:
             if not isinstance(c, int) or not 0 <= c < len(nodes):
                 raise RigFileError(data.path, f"node {i}: expected child indices below "
@@ -119,6 +122,12 @@ def _choose_skin(data):
     skins = g.skins or []
     if not skins:
         raise RigFileError(data.path, "expected a skinned mesh (a skin), got no skins")
+    for i, n in enumerate(g.nodes or []):
+        for key in ("mesh", "skin"):
+            value = getattr(n, key)
+            if value is not None and not (isinstance(value, int) and value >= 0):
+                raise RigFileError(data.path, f"node {i}: expected '{key}' to be an index, got "
+                                              f"{value!r}")
     bound = [[i for i, n in enumerate(g.nodes or []) if n.skin == s and n.mesh is not None]
              for s in range(len(skins))]
     chosen = next((s for s in range(len(skins)) if bound[s]), 0)
@@ -145,6 +154,9 @@ def _build_skeleton(data, skin_index, parent):
     g = data.gltf
     skin = g.skins[skin_index]
     nodes = g.nodes or []
+    if not isinstance(skin.joints or [], list):
+        raise RigFileError(data.path, f"skin {skin_index}: expected 'joints' to be a list of "
+                                      f"node indices, got {skin.joints!r}")
     joints = list(skin.joints or [])
     if not joints:
         raise RigFileError(data.path, f"skin {skin_index}: expected joints, got none")
@@ -280,6 +292,18 @@ def load_gltf(path):
         positions or matrices, an extension the file requires that rigedit lacks.
     """
     data = GltfData(path)
+    try:
+        return _load(data)
+    except RigFileError:
+        raise
+    except (TypeError, ValueError, KeyError, IndexError, AttributeError) as exc:
+        # a field of an unexpected kind that no specific check named (the specific checks
+        # above give the precise messages); still one line naming the file
+        raise RigFileError(data.path, f"expected valid glTF, got a malformed field "
+                                      f"({type(exc).__name__}: {exc})") from None
+
+
+def _load(data):
     parent = _node_parents(data)
     skin_index, mesh_nodes = _choose_skin(data)
     skeleton, smap = _build_skeleton(data, skin_index, parent)
