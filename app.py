@@ -63,6 +63,11 @@ def main(argv=None):
     errors_hook.enable_faulthandler()
     notifier = autosave.install_signal_handlers(app, window)  # noqa: F841 - keep it alive
     QtCore.QTimer.singleShot(0, lambda: autosave.offer_recovery(window))
+    # The compiled skinning kernels load (from numba's disk cache) in the background once the
+    # window is up, so they neither delay the first frame nor get compiled during a drag.
+    from rigedit.model import skinning_kernels
+
+    QtCore.QTimer.singleShot(500, skinning_kernels.start_loading)
     return app.exec_()
 
 

@@ -186,7 +186,8 @@ class SkinBinding:
                 raise RuntimeError(f"the compiled skinning kernels are not available "
                                    f"({skinning_kernels.error()})")
             return kernels
-        skinning_kernels.start_loading()
+        if self.num_vertices >= skinning_kernels.AUTO_LOAD_MIN_VERTICES:
+            skinning_kernels.start_loading()
         return skinning_kernels.ready()
 
     def _output(self, out):

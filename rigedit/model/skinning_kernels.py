@@ -6,9 +6,14 @@ The numpy code in :mod:`rigedit.model.skinning` and :mod:`rigedit.model.dqs` is 
 compiled. Importing numba takes about half a second and compiling these kernels several
 seconds, neither of which may show in the editor, so:
 
-- nothing here imports numba at module import; :func:`start_loading` (called when a
-  :class:`~rigedit.model.skinning.SkinBinding` is made) imports and compiles in a background
-  thread, and until that is done :func:`ready` returns None and skinning runs in numpy;
+- nothing here imports numba at module import; :func:`start_loading` imports and compiles
+  in a background thread, and until that is done :func:`ready` returns None and skinning runs
+  in numpy. A :class:`~rigedit.model.skinning.SkinBinding` of ``AUTO_LOAD_MIN_VERTICES`` or
+  more starts it at its first frame; smaller ones only use kernels someone loaded (the editor
+  calls :func:`start_loading` once its window shows): the background import holds Python's
+  lock much of its 1-2 s and measured to slow the foreground's work about 2x meanwhile, which
+  a short command or a small mesh (numpy: about 1 ms a frame at 30k vertices) does not win
+  back;
 - the compiled code is cached on disk (numba's ``cache=True``): in ``__pycache__`` beside this
   file when that folder is writable (a checkout, a user install), otherwise numba's per-user
   cache folder (``~/.cache/numba``, or ``$NUMBA_CACHE_DIR``), so only the very first run on a
@@ -26,7 +31,10 @@ import threading
 import numpy as np
 
 __all__ = ["ready", "load", "start_loading", "disabled", "error", "Kernels", "DISABLE_ENV",
-           "PARALLEL_MIN_VERTICES"]
+           "PARALLEL_MIN_VERTICES", "AUTO_LOAD_MIN_VERTICES"]
+
+#: A binding this big starts loading the kernels by itself (see the module's notes).
+AUTO_LOAD_MIN_VERTICES = 50_000
 
 DISABLE_ENV = "RIGEDIT_NO_NUMBA"
 # Reassociation and FMA contraction let LLVM vectorise the blends; no "fast" flags that
