@@ -7,7 +7,8 @@ rigedit format::
                  "times": [0.0, 0.5, 1.0], "values": [[x, y, z, w], ...]}, ...]}
 
 Values are local (parent-space) joint transforms, as in a Pose: translations, unit
-quaternions (x, y, z, w), scales.
+quaternions (x, y, z, w), scales. A ``cubic_spline`` track (glTF's CUBICSPLINE) also has
+``"tangents"``: per key, its in-tangent then its out-tangent (2 C numbers, units per second).
 
 elk format: ``{"name", "duration", "keyframes": {joint: [{"time", "rotation": [rx, ry, rz],
 "translation": [x, y, z], "scale": [x, y, z]}]}}`` with Euler radians composed Rz·Ry·Rx about
@@ -106,8 +107,13 @@ def _load_rigedit(path, data, skeleton):
         values = _floats(path, f"track {i} ({joint!r} {channel}) values",
                          require(path, e, "values", list, f" in track {i}"),
                          (len(times), CHANNELS[channel]))
+        tangents = e.get("tangents")
+        if tangents is not None:  # a cubic_spline track's in- and out-tangent per key
+            tangents = _floats(path, f"track {i} ({joint!r} {channel}) tangents", tangents,
+                               (len(times), 2 * CHANNELS[channel])).reshape(len(times), 2, -1)
         try:
-            tracks[(joint, channel)] = Track(channel, times, values, e.get("interpolation"))
+            tracks[(joint, channel)] = Track(channel, times, values, e.get("interpolation"),
+                                             tangents)
         except ValueError as exc:
             raise RigFileError(path, f"track {i} ({joint!r}): {exc}") from None
     _warn_unknown(path, set(unknown))
@@ -147,6 +153,9 @@ def clip_to_dict(clip):
     tracks = [{"joint": joint, "channel": channel, "interpolation": tr.interpolation,
                "times": tr.times.round(9).tolist(), "values": tr.values.round(9).tolist()}
               for (joint, channel), tr in clip.tracks.items()]
+    for entry, tr in zip(tracks, clip.tracks.values()):
+        if tr.interpolation == "cubic_spline":  # glTF's CUBICSPLINE keeps its own tangents
+            entry["tangents"] = tr.tangents.reshape(len(tr), -1).round(9).tolist()
     return {"format": "rigedit.clip", "version": 1, "name": clip.name,
             "duration": clip.duration, "loop": clip.loop, "tracks": tracks}
 

@@ -9,7 +9,9 @@ rigedit format::
 
 ``translation``/``rotation``/``scale`` are the local rest transform (parent space); ``tail``
 (optional) is the model-space end of the joint's bone; ``deform`` (optional, default true) says
-whether the joint takes skin weights.
+whether the joint takes skin weights; ``bind_matrix`` (optional, 4x4 rows) is the model-space
+matrix the mesh was bound at, written only when the bind pose differs from the rest pose's
+forward kinematics (glTF files may bind elsewhere); a joint without one binds at its rest.
 
 elk format: ``{"joints": [{"name", "index", "head", "tail", "parent"}], "bones", "hierarchy"}``
 with world-space heads and tails (Z up) and axis-aligned joint frames, so a joint's bind matrix
@@ -95,9 +97,37 @@ def _load_elk(path, data):
         raise RigFileError(path, str(exc)) from None
 
 
+def _bind_matrix(path, joint, value):
+    """(4, 4) float64 bind matrix of a joint (row-major nested lists), or None if absent."""
+    if value is None:
+        return None
+    try:
+        m = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        m = None
+    if m is None or m.shape != (4, 4) or not np.all(np.isfinite(m)) \
+            or not np.allclose(m[3], [0, 0, 0, 1]) or abs(np.linalg.det(m[:3, :3])) < 1e-12:
+        raise RigFileError(path, f"joint {joint!r}: expected 'bind_matrix' to be an invertible "
+                                 f"affine 4x4 matrix (rows, last [0, 0, 0, 1]), got "
+                                 f"{str(value)[:80]}")
+    return m
+
+
+def _bind_pose(t, r, s, parents, names, binds, order):
+    """(J, 4, 4) bind matrices in ``order``: the file's where given, the rest pose's forward
+    kinematics elsewhere; None when the file gives none."""
+    if all(b is None for b in binds):
+        return None
+    pos = {names[k]: i for i, k in enumerate(order)}
+    rest = Skeleton([names[k] for k in order],
+                    [-1 if parents[k] is None else pos[parents[k]] for k in order],
+                    np.array(t)[order], np.array(r)[order], np.array(s)[order]).bind_matrices
+    return np.stack([rest[i] if binds[k] is None else binds[k] for i, k in enumerate(order)])
+
+
 def _load_rigedit(path, data):
     joints = require(path, data, "joints", list)
-    names, parents, t, r, s, tails, deform = [], [], [], [], [], [], []
+    names, parents, t, r, s, tails, deform, binds = [], [], [], [], [], [], [], []
     for i, j in enumerate(joints):
         name = require(path, j, "name", str, f" in joint {i}")
         names.append(name)
@@ -107,13 +137,15 @@ def _load_rigedit(path, data):
         s.append(_vec(path, name, "scale", j.get("scale", [1, 1, 1]), 3))
         tails.append(_vec(path, name, "tail", j["tail"], 3) if "tail" in j else [np.nan] * 3)
         deform.append(bool(j.get("deform", True)))
+        binds.append(_bind_matrix(path, name, j.get("bind_matrix")))
     try:
         order = topological_order(names, parents)
         pos = {names[k]: i for i, k in enumerate(order)}
         return Skeleton([names[k] for k in order],
                         [-1 if parents[k] in (None, "") else pos[parents[k]] for k in order],
                         np.array(t)[order], np.array(r)[order], np.array(s)[order],
-                        tails=np.array(tails)[order], deform=np.array(deform)[order])
+                        tails=np.array(tails)[order], deform=np.array(deform)[order],
+                        bind_matrices=_bind_pose(t, r, s, parents, names, binds, order))
     except ValueError as exc:
         raise RigFileError(path, str(exc)) from None
 
@@ -142,6 +174,11 @@ def load_skeleton(path):
 def skeleton_to_dict(skeleton, up="y"):
     """rigedit-format dictionary of a skeleton."""
     joints = []
+    # bind matrices are written only when the mesh was bound elsewhere than the rest pose
+    # (glTF files may do that); the loader derives them from the rest pose otherwise
+    rest = skeleton.forward(skeleton.rest_local_matrices())
+    bind = not np.allclose(rest, skeleton.bind_matrices, rtol=0,
+                           atol=1e-9 * max(1.0, np.abs(rest).max()))
     for j, name in enumerate(skeleton.names):
         p = skeleton.parents[j]
         entry = {"name": name, "parent": None if p < 0 else skeleton.names[p],
@@ -152,6 +189,8 @@ def skeleton_to_dict(skeleton, up="y"):
             entry["tail"] = skeleton.tails[j].round(9).tolist()
         if not skeleton.deform[j]:
             entry["deform"] = False
+        if bind:
+            entry["bind_matrix"] = skeleton.bind_matrices[j].tolist()
         joints.append(entry)
     return {"format": "rigedit.skeleton", "version": 1, "up": up, "joints": joints}
 
