@@ -5,7 +5,7 @@ import numpy as np
 
 from .skinning import top_k_influences
 
-__all__ = ["METHODS", "compute_weights", "idw_weights", "point_segment_distance"]
+__all__ = ["METHODS", "compute_weights", "idw_weights", "point_segment_distance", "default_method"]
 
 
 def point_segment_distance(points, starts, ends, out=None):
@@ -95,20 +95,44 @@ def idw_weights(vertices, skeleton, max_influences=4, power=4.0, eps=1e-6, chunk
     return out_idx, out_w
 
 
-METHODS = {"idw": idw_weights}
+def heat(vertices, skeleton, faces=None, max_influences=4, progress=None, **options):
+    """Bone-heat weights; see :func:`rigedit.model.heat.heat_weights`.
+
+    Imported on first use: the compiled ray tests (numba) take a moment to load.
+    """
+    from .heat import heat_weights
+    return heat_weights(vertices, skeleton, faces, max_influences=max_influences,
+                        progress=progress, **options)
+
+
+METHODS = {"idw": idw_weights, "heat": heat}
+NEEDS_FACES = {"heat"}
 
 
 def compute_weights(vertices, skeleton, method="idw", max_influences=4, progress=None,
-                    **options):
+                    faces=None, **options):
     """Compute skinning weights with a named method.
 
     ``progress(fraction)`` is called as the work advances; an exception it raises (a
     cancel) stops the computation. Every method in ``METHODS`` takes it.
 
+    Parameters
+    ----------
+    vertices : (V, 3) float
+    skeleton : Skeleton
+    method : {"heat", "idw"}
+        ``heat`` (bone heat over the surface) needs ``faces``; ``idw`` (inverse distance to
+        the bones) ignores them.
+    max_influences : int
+    progress : callable(fraction), optional
+    faces : (F, 3) int, optional
+
     Returns
     -------
     indices : (V, K) int32
     weights : (V, K) float64
+        ``heat`` returns a :class:`rigedit.model.heat.WeightsResult`, which unpacks the same
+        and also says which vertices needed a fallback (``.fallback``).
     """
     if not 1 <= max_influences <= 8:
         raise ValueError(f"expected max_influences between 1 and 8, got {max_influences}")
@@ -117,5 +141,13 @@ def compute_weights(vertices, skeleton, method="idw", max_influences=4, progress
     except KeyError:
         raise ValueError(f"unknown weights method {method!r}; expected one of "
                          f"{', '.join(sorted(METHODS))}") from None
+    if method in NEEDS_FACES:
+        options["faces"] = faces
     return fn(vertices, skeleton, max_influences=max_influences, progress=progress,
               **options)
+
+
+def default_method(faces):
+    """The method to use when none is asked for: ``heat`` for a mesh with triangles,
+    ``idw`` for a point cloud."""
+    return "heat" if faces is not None and len(faces) else "idw"

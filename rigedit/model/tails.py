@@ -1,0 +1,164 @@
+"""Bone segments for automatic weights: which joints deform, and tails for tail-less leaves.
+
+Formats such as glTF and BVH give joints but no bone ends, so a leaf joint (a head, a hand
+without fingers, a toe) would be a single point and its influence a ball. Its tail is
+inferred from the part of the mesh it would own:
+
+1. the leaf's *region* is the set of vertices whose nearest bone segment is that leaf's
+   point (every other bone kept as a segment);
+2. the direction runs from the joint to the centroid of that region; when the region has
+   fewer than ``MIN_REGION`` vertices or its centroid is too close to the joint to give a
+   direction, the parent bone's direction is used instead;
+3. the length is ``REACH`` (0.8) of the farthest projection of the region's vertices on that
+   direction (without a region: half the parent bone's length);
+4. clipped to the mesh: at most ``REACH`` of the distance to the first surface crossing
+   along the direction, so the tail stays inside the body.
+
+Joints that take no weight: those flagged ``deform`` false, a joint whose every bone has zero
+length (a helper at the same place as its child), and a root *carrier*: a root at the model
+origin with one child whose bone lies mostly outside the body (a character standing on the
+ground with its root between the feet; "outside" is judged by the normal of the nearest
+vertex at ten points along the bone).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .laplacian import vertex_normals
+
+__all__ = ["deforming_joints", "bone_segments_with_tails", "infer_leaf_tails"]
+
+REACH = 0.8
+MIN_REGION = 3
+
+
+def deforming_joints(skeleton, vertices, faces):
+    """(J,) bool: joints that may take weight.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+    vertices : (V, 3) float64
+    faces : (F, 3) int64
+        The mesh, for the scale of "zero length" and the carrier test.
+    """
+    heads = skeleton.bind_matrices[:, :3, 3]
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    scale = max(float(np.linalg.norm(hi - lo)), 1e-12)
+    tiny = 1e-6 * scale
+    deform = skeleton.deform.copy()
+    for j in np.flatnonzero(deform):
+        kids = skeleton.children(j)
+        tail = skeleton.tails[j]
+        if np.all(np.isfinite(tail)):
+            ends = tail[None]
+        elif len(kids):
+            ends = heads[kids]
+        else:
+            continue  # a leaf: gets an inferred tail
+        if np.all(np.linalg.norm(ends - heads[j], axis=1) < tiny):
+            deform[j] = False
+    for j in np.flatnonzero(deform & (skeleton.parents < 0)):
+        kids = skeleton.children(j)
+        if np.linalg.norm(heads[j]) < tiny and len(kids) == 1:
+            along = heads[j] + np.linspace(0.05, 0.95, 10)[:, None] * (heads[kids[0]] - heads[j])
+            if _inside_fraction(along, vertices, faces) < 0.5:
+                deform[j] = False
+    if not deform.any():  # better one weighted joint than none: keep the flagged ones
+        deform = skeleton.deform.copy() if skeleton.deform.any() else np.ones(len(deform), bool)
+    return deform
+
+
+def _inside_fraction(points, vertices, faces):
+    """Share of ``points`` behind the surface at their nearest vertex (inside the body)."""
+    from scipy.spatial import cKDTree
+    normals = vertex_normals(vertices, faces)
+    _, near = cKDTree(vertices).query(points)
+    return float(np.mean(np.einsum("ij,ij->i", points - vertices[near], normals[near]) < 0))
+
+
+def bone_segments_with_tails(skeleton, deform, tails):
+    """Segments of the deforming joints, with given tails for leaves.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+    deform : (J,) bool
+    tails : (J, 3) float64
+        Model-space tails; NaN rows where a joint has none (a non-leaf then runs to each
+        child, a leaf is a point).
+
+    Returns
+    -------
+    starts, ends : (S, 3) float64
+    owners : (S,) int64
+    """
+    heads = skeleton.bind_matrices[:, :3, 3]
+    starts, ends, owners = [], [], []
+    for j in np.flatnonzero(deform):
+        kids = skeleton.children(j)
+        if np.all(np.isfinite(tails[j])):
+            targets = tails[j][None]
+        elif len(kids):
+            targets = heads[kids]
+        else:
+            targets = heads[j][None]
+        starts.append(np.repeat(heads[j][None], len(targets), axis=0))
+        ends.append(targets)
+        owners.append(np.full(len(targets), j))
+    return np.concatenate(starts), np.concatenate(ends), np.concatenate(owners)
+
+
+def infer_leaf_tails(skeleton, deform, vertices, nearest_owner, rays=None):
+    """Tails for deforming leaf joints that have none (see the module notes).
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+    deform : (J,) bool
+    vertices : (V, 3) float64
+    nearest_owner : (V,) int
+        For each vertex, the joint owning its nearest segment, leaves taken as points.
+    rays : SurfaceRays, optional
+        For clipping tails to the mesh.
+
+    Returns
+    -------
+    tails : (J, 3) float64
+        The skeleton's tails with inferred ones filled in (NaN elsewhere).
+    """
+    heads = skeleton.bind_matrices[:, :3, 3]
+    tails = skeleton.tails.copy()
+    todo = [j for j in np.flatnonzero(deform)
+            if not np.all(np.isfinite(tails[j])) and len(skeleton.children(j)) == 0]
+    if not todo:
+        return tails
+    dirs, lengths = np.zeros((len(todo), 3)), np.zeros(len(todo))
+    order = np.argsort(nearest_owner, kind="stable")
+    bounds = np.searchsorted(nearest_owner[order], [todo, np.add(todo, 1)])
+    for n, j in enumerate(todo):  # a loop over leaf joints, not vertices
+        region = vertices[order[bounds[0, n]:bounds[1, n]]] - heads[j]
+        p = skeleton.parents[j]
+        parent_dir = heads[j] - heads[p] if p >= 0 else np.zeros(3)
+        d = region.mean(axis=0) if len(region) >= MIN_REGION else np.zeros(3)
+        spread = np.linalg.norm(region, axis=1).max() if len(region) else 0.0
+        if np.linalg.norm(d) < 0.1 * spread or len(region) < MIN_REGION:
+            d = parent_dir
+        norm = np.linalg.norm(d)
+        if norm < 1e-12:
+            continue  # nothing to go on: the leaf stays a point
+        d = d / norm
+        if len(region) >= MIN_REGION:
+            length = REACH * max(float((region @ d).max()), 0.0)
+        else:
+            length = 0.5 * np.linalg.norm(parent_dir)
+        dirs[n], lengths[n] = d, length
+    if rays is not None:
+        idx = np.array(todo)
+        far = heads[idx] + dirs * np.maximum(lengths, 1e-12)[:, None] / REACH
+        t = rays.first_hit(heads[idx], far)
+        lengths = lengths * np.where(np.isfinite(t), np.minimum(t, 1.0), 1.0)
+    for n, j in enumerate(todo):
+        if lengths[n] > 0:
+            tails[j] = heads[j] + dirs[n] * lengths[n]
+    return tails
