@@ -136,3 +136,23 @@ def test_compiled_rigid_dual_quaternions_match_numpy_and_refuse_scale():
     mirrored = pal.copy()
     mirrored[3, :3, 0] *= -1
     assert not kernels.rigid_dual_quaternions(mirrored, 1e-6, dq)
+
+
+def test_a_big_binding_loads_the_kernels_in_the_background_and_a_small_one_does_not():
+    code = ("import numpy as np\n"
+            "from rigedit.model import SkinBinding, skinning_kernels as k\n"
+            "p = np.tile(np.eye(4), (2, 1, 1))\n"
+            "small = SkinBinding(np.zeros((10, 3)), np.zeros((10, 1), int), np.ones((10, 1)), 2)\n"
+            "small.skin(p)\n"
+            "print(k._state['thread'] is None, k.ready() is None)\n"
+            "n = k.AUTO_LOAD_MIN_VERTICES\n"
+            "big = SkinBinding(np.random.default_rng(0).normal(size=(n, 3)),\n"
+            "                  np.zeros((n, 1), int), np.ones((n, 1)), 2)\n"
+            "first = big.skin(p).copy()  # numpy: the kernels are still loading\n"
+            "k._state['thread'].join(300)\n"
+            "print(k.ready() is not None, np.allclose(big.skin(p), first, atol=1e-6))\n")
+    env = {k: v for k, v in os.environ.items() if k != skinning_kernels.DISABLE_ENV}
+    proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                          text=True, timeout=400)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["True", "True", "True", "True"]
