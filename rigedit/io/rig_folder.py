@@ -76,7 +76,7 @@ def find_rig_files(folder):
     anim_dir = folder / "animations"
     animations = sorted(anim_dir.glob("*.json")) if anim_dir.is_dir() else []
     return {"meshes": meshes, "skeleton": skeleton,
-            "weights": weights if weights.is_file() else None,
+            "weights": weights if meshes and weights.is_file() else None,  # none without a mesh
             "animations": animations, "manifest": manifest}
 
 
