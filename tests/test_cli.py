@@ -141,21 +141,23 @@ def _start_render(rig_dir, out, extra=()):
 def test_interrupted_render_removes_its_temporary_file(rig_dir, tmp_path):
     """Ctrl-C (SIGINT to the whole process group, ffmpeg too) and SIGTERM (to the process)
     in the middle of MP4 and GIF renders: exit 130/143, one line, no temporary file left."""
-    cases = [(signal.SIGINT, ".mp4", True), (signal.SIGTERM, ".gif", False),
-             (signal.SIGTERM, ".mp4", False)]
+    # (signal, video, to the whole group, seconds after the temporary file appears): at 0 the
+    # signal lands while ffmpeg starts, before the first frame
+    cases = [(signal.SIGINT, ".mp4", True, 0.5), (signal.SIGTERM, ".gif", False, 0.5),
+             (signal.SIGTERM, ".mp4", False, 0.5), (signal.SIGINT, ".mp4", True, 0.0)]
     runs = []
-    for i, (sig, suffix, group) in enumerate(cases):   # started together: startup dominates
+    for i, (sig, suffix, group, delay) in enumerate(cases):   # together: startup dominates
         out = tmp_path / f"out{i}" / f"v{suffix}"
         out.parent.mkdir()
-        runs.append((sig, group, out, _start_render(rig_dir, out)))
-    for sig, group, out, proc in runs:
+        runs.append((sig, group, delay, out, _start_render(rig_dir, out)))
+    for sig, group, delay, out, proc in runs:
         deadline = time.monotonic() + 120
         while not _hidden(out.parent) and proc.poll() is None and time.monotonic() < deadline:
-            time.sleep(0.05)
+            time.sleep(0.01)
         assert proc.poll() is None and _hidden(out.parent), "the render did not start writing"
-        time.sleep(0.3)   # some frames in
+        time.sleep(delay)
         (os.killpg if group else os.kill)(proc.pid, sig)
-    for sig, group, out, proc in runs:
+    for sig, group, delay, out, proc in runs:
         _, err = proc.communicate(timeout=60)
         assert proc.returncode == 128 + sig
         assert err.splitlines() == [f"rigedit: interrupted by {signal.Signals(sig).name}"], err

@@ -63,12 +63,18 @@ def temp_beside(path, suffix=None):
     except OSError as exc:  # say which file could not be written, not the temporary name
         raise type(exc)(exc.errno, exc.strerror, str(path)) from None
     try:
-        mode = path.stat().st_mode & 0o777
-    except OSError:
-        umask = os.umask(0)
-        os.umask(umask)
-        mode = 0o666 & ~umask
-    os.chmod(tmp, mode)
+        try:
+            mode = path.stat().st_mode & 0o777
+        except OSError:
+            umask = os.umask(0)
+            os.umask(umask)
+            mode = 0o666 & ~umask
+        os.chmod(tmp, mode)
+    except BaseException:   # an interrupt here must not leave the empty file behind
+        os.close(fd)
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
     return fd, tmp
 
 

@@ -55,11 +55,16 @@ class _Writer:
         self.tmp = Path(tmp)
         self.frames = []
         if not self.gif:
-            # ffmpeg encodes in its own process while the next frame renders here
-            self.writer = imageio.get_writer(
-                str(self.tmp), format="FFMPEG", mode="I", fps=fps, codec="libx264",
-                pixelformat="yuv420p", quality=quality, macro_block_size=2,
-                output_params=["-preset", preset], ffmpeg_log_level="error")
+            try:
+                # ffmpeg encodes in its own process while the next frame renders here
+                self.writer = imageio.get_writer(
+                    str(self.tmp), format="FFMPEG", mode="I", fps=fps, codec="libx264",
+                    pixelformat="yuv420p", quality=quality, macro_block_size=2,
+                    output_params=["-preset", preset], ffmpeg_log_level="error")
+            except BaseException:   # Ctrl-C while ffmpeg starts: no writer to abort yet
+                with contextlib.suppress(OSError):
+                    self.tmp.unlink()
+                raise
 
     def append(self, frame):
         if self.gif:
