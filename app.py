@@ -68,6 +68,7 @@ def main(argv=None):
     from rigedit.model import skinning_kernels
 
     QtCore.QTimer.singleShot(500, skinning_kernels.start_loading)
+    window.confirm_close = True  # Save / Discard / Cancel when closing with unsaved changes
     return app.exec_()
 
 

@@ -103,6 +103,37 @@ def test_each_window_has_its_own_entry(make_editor):
     assert b.autosave.crash_save() and b.autosave.writes == 2
 
 
+def test_closing_with_unsaved_changes_asks(make_editor, monkeypatch, tmp_path):
+    from rigedit.ui import autosave
+
+    answers = []
+    monkeypatch.setattr(autosave, "ask_save_changes", lambda w: answers.pop(0))
+    w = make_editor()
+    w.confirm_close = True
+    assert w.close()  # nothing unsaved: no question
+    w = make_editor()
+    w.confirm_close = True
+    w.document.set_joint_euler(3, [0, 0, 25])
+    assert w.autosave.save()
+    answers[:] = ["cancel"]
+    assert not w.close() and w.isVisible() and len(_entries()) == 1
+    # Save on a rig that has no folder yet asks where (Save As); a cancelled Save As keeps
+    # the window open.
+    folder = []
+    monkeypatch.setattr("PyQt5.QtWidgets.QFileDialog.getExistingDirectory",
+                        lambda *a, **k: folder.pop(0))
+    answers[:], folder[:] = ["save"], [""]
+    assert not w.close() and w.isVisible() and w.document.modified
+    answers[:], folder[:] = ["save"], [str(tmp_path / "saved")]
+    assert w.close() and (tmp_path / "saved" / "skeleton.json").is_file()
+    assert _entries() == []
+    w = make_editor()
+    w.confirm_close = True
+    w.document.set_joint_euler(3, [0, 0, 25])
+    answers[:] = ["discard"]
+    assert w.close() and _entries() == [] and answers == []
+
+
 def _stale_entry(rig, pose, clip, t, original):
     """An entry as left by an editor process that no longer runs."""
     from rigedit import recovery

@@ -20,7 +20,7 @@ from ..errors import RigFileError
 from . import errors_hook
 
 __all__ = ["Autosave", "DEFAULT_INTERVAL", "offer_recovery", "ask_recover", "recover",
-           "install_signal_handlers"]
+           "install_signal_handlers", "ask_save_changes", "confirm_unsaved_changes"]
 
 DEFAULT_INTERVAL = 120.0  # seconds (Blender's default is 2 minutes too)
 
@@ -197,6 +197,33 @@ def recover(window, entry):
         recovery.remove_entry(entry.folder)
     window.status(f"Recovered {entry.describe()}; save it to keep it")
     return True
+
+
+# ---------------------------------------------------------------------- closing
+def ask_save_changes(window):
+    """Ask about unsaved changes on close: "save", "discard" or "cancel"."""
+    box = QtWidgets.QMessageBox(window)
+    box.setIcon(QtWidgets.QMessageBox.Warning)
+    box.setWindowTitle("Unsaved changes")
+    box.setText(f"Save the changes to {window.document.rig.name} before closing?")
+    box.setInformativeText("Closing without saving loses them (no recovery file is kept).")
+    box.setStandardButtons(QtWidgets.QMessageBox.Save | QtWidgets.QMessageBox.Discard
+                           | QtWidgets.QMessageBox.Cancel)
+    box.setDefaultButton(QtWidgets.QMessageBox.Save)
+    answer = box.exec_()
+    return {QtWidgets.QMessageBox.Save: "save",
+            QtWidgets.QMessageBox.Discard: "discard"}.get(answer, "cancel")
+
+
+def confirm_unsaved_changes(window, ask=None):
+    """Whether the window may close: no unsaved changes, or the user discarded them, or
+    they were saved (File > Save; Save As when there is no folder to save to)."""
+    if not window.document.modified:
+        return True
+    choice = (ask or ask_save_changes)(window)
+    if choice == "save":
+        return bool(window.files.save()) and not window.document.modified
+    return choice == "discard"
 
 
 # ---------------------------------------------------------------------- signals

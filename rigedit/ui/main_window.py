@@ -17,7 +17,7 @@ from ..document import Document
 from ..render.gizmos import AxisHandles, JointGizmos, gizmo_radius, overlay_renderer
 from ..render.scene import RigScene
 from . import errors_hook
-from .autosave import Autosave
+from .autosave import Autosave, confirm_unsaved_changes
 from .drag import DragMixin
 from .menus import MenusMixin
 from .file_actions import FileActions
@@ -86,6 +86,8 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
         self.job = None
         self._pending_rebind = None  # (job, undo-stack top at its start, label)
         self.keep_recovery = False   # set when quitting on a signal: the entry must stay
+        self.confirm_close = False   # ask about unsaved changes on close (app.py sets it)
+        self._closed = False
         self.gizmos = None
         self.axes = None
         self._drag = None
@@ -471,6 +473,14 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
         return image
 
     def closeEvent(self, event):
+        if self._closed:  # closed before (tests close twice): nothing left to ask or free
+            super().closeEvent(event)
+            return
+        if self.confirm_close and not self.keep_recovery \
+                and not confirm_unsaved_changes(self):
+            event.ignore()  # the user chose Cancel, or the save did not happen
+            return
+        self._closed = True
         if self.job is not None:
             self.job.cancel()
             self.job.wait(5000)
