@@ -26,7 +26,8 @@ from scipy.spatial.transform import Rotation
 from ..animation.clip import CHANNELS, Clip, Track
 from ..errors import RigFileError
 from .atomic import write_json
-from .jsonfile import read_json, require
+from .jsonfile import (MAX_SECONDS, boolean, choice, name, number, numbers, optional,
+                       read_json, require, vector)
 
 __all__ = ["load_clip", "save_clip", "clip_to_dict", "UnknownJointsWarning"]
 
@@ -35,22 +36,19 @@ class UnknownJointsWarning(UserWarning):
     """A clip names joints that the skeleton lacks; their keys were skipped."""
 
 
-def _floats(path, where, value, shape):
-    try:
-        arr = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        arr = None
-    if arr is None or arr.shape[1:] != shape[1:] or (shape[0] and arr.shape[0] != shape[0]) \
-            or not np.all(np.isfinite(arr)):
-        raise RigFileError(path, f"{where}: expected numbers of shape "
-                                 f"{tuple('K' if s == 0 else s for s in shape)}, got {value!r:.80}")
-    return arr
-
-
 def _warn_unknown(path, unknown):
     if unknown:
         warnings.warn(f"{path}: skipped keys for joints the skeleton lacks: "
                       f"{', '.join(sorted(unknown))}", UnknownJointsWarning, stacklevel=3)
+
+
+def _duration(path, data):
+    value = optional(data, "duration", None)
+    return None if value is None else number(path, value, "'duration'", 0.0, MAX_SECONDS)
+
+
+def _loop(path, data):
+    return boolean(path, optional(data, "loop", True), "'loop'")
 
 
 def _load_elk(path, data, skeleton):
@@ -61,17 +59,21 @@ def _load_elk(path, data, skeleton):
             unknown.append(joint)
             continue
         if not isinstance(keys, list) or not keys:
-            raise RigFileError(path, f"joint {joint!r}: expected a list of keyframes")
+            raise RigFileError(path, f"joint {joint!r}: expected a list of keyframes, got "
+                                     f"{type(keys).__name__}")
         j = skeleton.index[joint]
-        times = _floats(path, f"joint {joint!r} times",
-                        [require(path, k, "time", (int, float), f" in a key of {joint!r}")
-                         for k in keys], (0,))
-        euler = _floats(path, f"joint {joint!r} rotation",
-                        [k.get("rotation", [0, 0, 0]) for k in keys], (0, 3))
-        offset = _floats(path, f"joint {joint!r} translation",
-                         [k.get("translation", [0, 0, 0]) for k in keys], (0, 3))
-        scale = _floats(path, f"joint {joint!r} scale",
-                        [k.get("scale", [1, 1, 1]) for k in keys], (0, 3))
+        times, euler, offset, scale = [], [], [], []
+        for i, k in enumerate(keys):
+            where = f"joint {joint!r} key {i}"
+            times.append(number(path, require(path, k, "time", (int, float), f" in {where}"),
+                                "'time'", -MAX_SECONDS, MAX_SECONDS, where=where))
+            euler.append(vector(path, optional(k, "rotation", [0, 0, 0]), 3, "'rotation'",
+                                where=where))
+            offset.append(vector(path, optional(k, "translation", [0, 0, 0]), 3,
+                                 "'translation'", where=where))
+            scale.append(vector(path, optional(k, "scale", [1, 1, 1]), 3, "'scale'",
+                                where=where))
+        euler, offset, scale = np.array(euler), np.array(offset), np.array(scale)
         rest = Rotation.from_quat(skeleton.rest_rotation[j])
         quats = (rest * Rotation.from_euler("xyz", euler)).as_quat()
         try:
@@ -84,40 +86,39 @@ def _load_elk(path, data, skeleton):
         except ValueError as exc:
             raise RigFileError(path, f"joint {joint!r}: {exc}") from None
     _warn_unknown(path, unknown)
-    duration = data.get("duration")
-    if duration is not None and not isinstance(duration, (int, float)):
-        raise RigFileError(path, f"expected 'duration' to be a number, got {duration!r}")
-    return tracks, duration, bool(data.get("loop", True))
+    return tracks, _duration(path, data), _loop(path, data)
 
 
 def _load_rigedit(path, data, skeleton):
     entries = require(path, data, "tracks", list)
     tracks, unknown = {}, []
     for i, e in enumerate(entries):
-        joint = require(path, e, "joint", str, f" in track {i}")
-        channel = require(path, e, "channel", str, f" in track {i}")
-        if channel not in CHANNELS:
-            raise RigFileError(path, f"track {i} ({joint!r}): expected channel in "
-                                     f"{sorted(CHANNELS)}, got {channel!r}")
+        joint = name(path, require(path, e, "joint", str, f" in track {i}"), "'joint'",
+                     where=f"track {i}")
+        channel = choice(path, require(path, e, "channel", str, f" in track {i}"), "'channel'",
+                         tuple(CHANNELS), where=f"track {i} ({joint!r})")
         if joint not in skeleton.index:
             unknown.append(joint)
             continue
-        times = _floats(path, f"track {i} ({joint!r} {channel}) times",
-                        require(path, e, "times", list, f" in track {i}"), (0,))
-        values = _floats(path, f"track {i} ({joint!r} {channel}) values",
-                         require(path, e, "values", list, f" in track {i}"),
-                         (len(times), CHANNELS[channel]))
-        tangents = e.get("tangents")
+        where = f"track {i} ({joint!r} {channel})"
+        times = numbers(path, require(path, e, "times", list, f" in track {i}"),
+                        "'times'", bound=MAX_SECONDS, where=where)
+        values = numbers(path, require(path, e, "values", list, f" in track {i}"),
+                         "'values'", width=CHANNELS[channel], count=len(times), where=where)
+        mode = optional(e, "interpolation", None)
+        if mode is not None and not isinstance(mode, str):
+            raise RigFileError(path, f"{where}: expected 'interpolation' to be a name, got "
+                                     f"{type(mode).__name__}")
+        tangents = optional(e, "tangents", None)
         if tangents is not None:  # a cubic_spline track's in- and out-tangent per key
-            tangents = _floats(path, f"track {i} ({joint!r} {channel}) tangents", tangents,
-                               (len(times), 2 * CHANNELS[channel])).reshape(len(times), 2, -1)
+            tangents = numbers(path, tangents, "'tangents'", width=2 * CHANNELS[channel],
+                               count=len(times), where=where).reshape(len(times), 2, -1)
         try:
-            tracks[(joint, channel)] = Track(channel, times, values, e.get("interpolation"),
-                                             tangents)
+            tracks[(joint, channel)] = Track(channel, times, values, mode, tangents)
         except ValueError as exc:
             raise RigFileError(path, f"track {i} ({joint!r}): {exc}") from None
     _warn_unknown(path, set(unknown))
-    return tracks, data.get("duration"), bool(data.get("loop", True))
+    return tracks, _duration(path, data), _loop(path, data)
 
 
 def load_clip(path, skeleton):
@@ -141,9 +142,10 @@ def load_clip(path, skeleton):
     else:
         raise RigFileError(path, "expected a clip with 'tracks' (rigedit) or 'keyframes' (elk), "
                                  "got neither")
-    name = data.get("name") or path.stem
+    clip_name = optional(data, "name", "")
+    clip_name = path.stem if clip_name == "" else name(path, clip_name, "'name'")
     try:
-        return Clip(str(name), skeleton, tracks, duration, loop)
+        return Clip(clip_name, skeleton, tracks, duration, loop)
     except ValueError as exc:
         raise RigFileError(path, str(exc)) from None
 

@@ -14,6 +14,7 @@ import importlib
 from pathlib import Path
 
 from ..errors import RigFileError
+from .paths import what_is
 
 __all__ = ["load_rig", "RIG_FILE_SUFFIXES", "rig_kind", "format_function"]
 
@@ -29,7 +30,7 @@ def rig_kind(path):
         return "gltf"
     if suffix == ".bvh":
         return "bvh"
-    if path.is_dir() or not path.exists():  # a missing path is reported as a missing folder
+    if what_is(path) in ("a folder", None):  # a missing path is reported as a missing folder
         return "folder"
     raise RigFileError(path, "expected a rig folder or a .glb, .gltf or .bvh file, got a "
                              f"{suffix or 'suffix-less'} file")
@@ -45,7 +46,7 @@ def format_function(module, function, path, role="reader"):
                                  f"(rigedit.io.{module}.{function}), got none: {exc}") from exc
 
 
-def load_rig(rig=None, weights_method="idw", scale=None):
+def load_rig(rig=None, weights_method=None, scale=None):
     """Load a rig from a bundled name, a rig folder, a glTF/GLB file or a BVH file.
 
     Parameters
@@ -76,9 +77,8 @@ def load_rig(rig=None, weights_method="idw", scale=None):
     if scale is not None and kind != "bvh":
         raise RigFileError(path, f"expected --scale/scale= only with a .bvh file (BVH has no "
                                  f"units), got it with a {kind}")
-    if kind != "folder" and not path.is_file():
-        raise RigFileError(path, "expected a file, got " +
-                           ("a folder" if path.exists() else "nothing (not found)"))
+    if kind != "folder" and what_is(path) != "a file":
+        raise RigFileError(path, f"expected a file, got {what_is(path) or 'nothing (not found)'}")
     if kind == "bvh":
         return format_function("bvh", "load_bvh", path)(path, scale=scale)
     if kind == "gltf":

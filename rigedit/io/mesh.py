@@ -1,12 +1,17 @@
 """Triangle meshes from OBJ (own fast reader), PLY, STL, VTK, VTU (meshio) and VTP."""
 from __future__ import annotations
 
+import contextlib
+import io
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import RigFileError
 from .atomic import atomic_write
+from .jsonfile import MAX_MAGNITUDE
+from .paths import read_bytes, regular_file
 
 __all__ = ["MESH_SUFFIXES", "load_mesh", "save_obj", "weld_vertices", "triangulate"]
 
@@ -40,61 +45,125 @@ def weld_vertices(vertices, faces, decimals=9):
     return vertices[first[order]], new_faces[keep]
 
 
+#: Largest vertex index a face may use (int32, as every mesh format and VTK store them).
+MAX_INDEX = 2**31 - 1
+
+
+def _obj_face(path, lineno, tokens, n):
+    """0-based vertex indices of an OBJ face line (``f v/vt/vn ...``); negative indices count
+    back from the last vertex read so far."""
+    try:
+        idx = [int(tok.split("/")[0]) for tok in tokens]
+    except ValueError:
+        raise RigFileError(path, f"line {lineno}: expected face indices, got "
+                                 f"{' '.join(tokens)[:60]!r}") from None
+    if len(idx) < 3:
+        raise RigFileError(path, f"line {lineno}: a face needs 3 vertices, got "
+                                 f"{len(idx)}")
+    out = []
+    for i in idx:
+        if i == 0:
+            raise RigFileError(path, f"line {lineno}: face index 0 (OBJ indices start at 1, "
+                                     "or count back from -1)")
+        if abs(i) > MAX_INDEX:
+            raise RigFileError(path, f"line {lineno}: expected face indices up to {MAX_INDEX},"
+                                     f" got {str(i)[:30]}")
+        out.append(i - 1 if i > 0 else n + i)
+    return out
+
+
 def _read_obj(path):
+    raw = read_bytes(path)
+    if b"\0" in raw[:65536]:
+        raise RigFileError(path, "expected a text OBJ file, got binary data")
     verts, polys = [], []
-    with open(path, encoding="utf-8", errors="replace") as fh:
-        for lineno, line in enumerate(fh, 1):
-            if line.startswith("v "):
-                parts = line.split()
-                try:
-                    verts.append((float(parts[1]), float(parts[2]), float(parts[3])))
-                except (IndexError, ValueError):
-                    raise RigFileError(path, f"line {lineno}: expected 'v x y z', got "
-                                             f"{line.strip()!r}") from None
-            elif line.startswith("f "):
-                try:
-                    # "f v/vt/vn ..." -> position indices; negative indices count from the end
-                    idx = [int(tok.split("/")[0]) for tok in line.split()[1:]]
-                except ValueError:
-                    raise RigFileError(path, f"line {lineno}: expected face indices, got "
-                                             f"{line.strip()!r}") from None
-                if len(idx) < 3:
-                    raise RigFileError(path, f"line {lineno}: a face needs 3 vertices, got "
-                                             f"{len(idx)}")
-                n = len(verts)
-                polys.append([i - 1 if i > 0 else n + i for i in idx])
+    # utf-8-sig: a byte-order mark at the start is not part of the first line.
+    for lineno, line in enumerate(raw.decode("utf-8-sig", errors="replace").splitlines(), 1):
+        tokens = line.split()  # any whitespace: tabs and leading spaces are valid OBJ
+        if not tokens:
+            continue
+        if tokens[0] == "v":
+            try:
+                verts.append((float(tokens[1]), float(tokens[2]), float(tokens[3])))
+            except (IndexError, ValueError):
+                raise RigFileError(path, f"line {lineno}: expected 'v x y z', got "
+                                         f"{line.strip()[:60]!r}") from None
+        elif tokens[0] == "f":
+            polys.append(_obj_face(path, lineno, tokens[1:], len(verts)))
     vertices = np.array(verts, dtype=np.float64).reshape(-1, 3)
     faces = triangulate(polys)
     return vertices, faces
 
 
+def _third_party(path, read):
+    """Call a third-party reader so that nothing it does reaches the user: its prints go to a
+    buffer, a ``sys.exit`` or any exception becomes a ``RigFileError`` naming the file."""
+    out = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out), \
+                warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return read()
+    except RigFileError:
+        raise
+    except (Exception, SystemExit) as exc:  # meshio calls sys.exit(1) on an unreadable file
+        said = " ".join(out.getvalue().split())
+        detail = str(exc) if not isinstance(exc, SystemExit) else ""
+        detail = " ".join((detail or said or type(exc).__name__).split())
+        raise RigFileError(path, f"cannot read mesh: {detail[:200]}") from None
+
+
 def _read_meshio(path):
     import meshio  # imported here: only these formats need it
 
-    try:
-        m = meshio.read(path)
-    except Exception as exc:  # meshio raises many types for a bad file
-        raise RigFileError(path, f"cannot read mesh: {exc}") from None
+    m = _third_party(path, lambda: meshio.read(path))
     polys = []
     for block in m.cells:
-        if block.type == "triangle":
-            polys.extend(block.data.tolist())
-        elif block.type in ("quad", "polygon"):
-            polys.extend(block.data.tolist())
-    return np.asarray(m.points, dtype=np.float64)[:, :3], triangulate(polys)
+        if block.type in ("triangle", "quad", "polygon"):
+            data = np.asarray(block.data)
+            if data.dtype.kind not in "iu":
+                raise RigFileError(path, f"expected integer face indices, got {data.dtype}")
+            polys.extend(data.tolist())
+    points = np.asarray(m.points)
+    if points.ndim != 2 or points.shape[1] < 3 or points.dtype.kind not in "iuf":
+        raise RigFileError(path, f"expected 3D points, got an array of shape {points.shape}")
+    if any(i < 0 or i > MAX_INDEX for p in polys for i in (min(p, default=0), max(p, default=0))):
+        raise RigFileError(path, f"expected face indices from 0 to {MAX_INDEX}")
+    return points[:, :3].astype(np.float64), triangulate(polys)
 
 
 def _read_vtp(path):
-    # VTP (XML PolyData) is not among meshio's formats; pyvista reads it. This is the one
-    # place below rigedit/render that touches pyvista, and only when a VTP file is opened.
-    import pyvista as pv
+    # VTP (XML PolyData) is not among meshio's formats; VTK reads it. This is the one place
+    # below rigedit/render that touches VTK, and only when a VTP file is opened. VTK prints a
+    # bad file's errors to the terminal from C++ (its logger and output window, observers
+    # see only some of them): display is off for the read, and an empty result is the error.
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkCommonCore import vtkObject
+    from vtkmodules.vtkFiltersCore import vtkTriangleFilter
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
 
+    def read():
+        reader = vtkXMLPolyDataReader()
+        reader.SetFileName(str(path))
+        tri = vtkTriangleFilter()
+        tri.SetInputConnection(reader.GetOutputPort())
+        tri.PassVertsOff()
+        tri.PassLinesOff()
+        tri.Update()
+        return reader.GetErrorCode(), tri.GetOutput()
+
+    shown = vtkObject.GetGlobalWarningDisplay()
+    vtkObject.GlobalWarningDisplayOff()
     try:
-        poly = pv.read(path).extract_surface().triangulate()
-    except Exception as exc:
-        raise RigFileError(path, f"cannot read mesh: {exc}") from None
-    return np.asarray(poly.points, dtype=np.float64), poly.faces.reshape(-1, 4)[:, 1:].astype(
-        np.int64)
+        code, poly = _third_party(path, read)
+    finally:
+        vtkObject.SetGlobalWarningDisplay(shown)
+    if poly is None or poly.GetNumberOfPoints() == 0 or poly.GetPolys() is None:
+        raise RigFileError(path, "cannot read mesh: expected VTK XML PolyData with points, "
+                                 f"got none (VTK error code {code})")
+    points = vtk_to_numpy(poly.GetPoints().GetData()).astype(np.float64)
+    conn = vtk_to_numpy(poly.GetPolys().GetConnectivityArray()).astype(np.int64)
+    return points, conn.reshape(-1, 3) if len(conn) % 3 == 0 else triangulate([])
 
 
 def load_mesh(path, weld=True):
@@ -117,8 +186,7 @@ def load_mesh(path, weld=True):
         Missing file, unknown format, malformed content, no triangles, indices out of range.
     """
     path = Path(path)
-    if not path.is_file():
-        raise RigFileError(path, "file not found")
+    regular_file(path)
     suffix = path.suffix.lower()
     if suffix == ".obj":
         vertices, faces = _read_obj(path)
@@ -132,10 +200,15 @@ def load_mesh(path, weld=True):
     if len(faces) == 0:
         raise RigFileError(path, "expected triangles or polygons, got no faces")
     if faces.min() < 0 or faces.max() >= len(vertices):
+        bad = int(faces.max()) if faces.max() >= len(vertices) else int(faces.min())
         raise RigFileError(path, f"face index out of range: {len(vertices)} vertices, index "
-                                 f"{int(faces.max()) + 1 if faces.max() >= len(vertices) else int(faces.min()) + 1}")
+                                 f"{bad + 1} (1-based)")
     if not np.all(np.isfinite(vertices)):
         raise RigFileError(path, "expected finite vertex coordinates, got NaN or inf")
+    if np.abs(vertices).max() > MAX_MAGNITUDE:
+        raise RigFileError(path, f"expected vertex coordinates within +-{MAX_MAGNITUDE:g}, got "
+                                 f"{np.abs(vertices).max():g}")
+    _check_area(path, vertices, faces)
     if weld:
         vertices, faces = weld_vertices(vertices, faces)
     # Keep only referenced vertices: stray points would get weights and bounding boxes wrong.
@@ -145,6 +218,18 @@ def load_mesh(path, weld=True):
         remap = np.cumsum(used) - 1
         vertices, faces = vertices[used], remap[faces]
     return vertices, faces
+
+
+def _check_area(path, vertices, faces):
+    """An error when every face is degenerate (a repeated vertex or no area): such a mesh has
+    no surface to show or to skin. Some degenerate faces among good ones are kept as read."""
+    tri = vertices[faces]
+    area2 = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    keep = ((faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2])
+            & (faces[:, 0] != faces[:, 2]) & (area2 > 0))
+    if not keep.any():
+        raise RigFileError(path, f"expected faces with an area, got none among {len(faces)} "
+                                 "(each repeats a vertex or has its corners on a line)")
 
 
 def save_obj(path, vertices, faces, header=None):

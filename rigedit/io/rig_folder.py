@@ -21,13 +21,15 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RigFileError
+from ..model.weights import default_method
 from ..rig import Rig
 from .clip_json import load_clip
 from .frames import change_axes, resolve_folder_frames
-from .jsonfile import read_json
+from .jsonfile import choice, name, read_json, relative_path
 from .mesh import MESH_SUFFIXES, load_mesh
 from .rig_save import recover_interrupted_save, remember_clip_files, save_rig_folder_atomic
-from .skeleton_json import load_skeleton
+from .paths import list_folder, what_is
+from .skeleton_json import UP_AXES, load_skeleton
 from .weights_npz import load_weights, weights_vertex_count
 
 __all__ = ["load_rig_folder", "save_rig_folder", "find_rig_files", "WeightsComputedWarning"]
@@ -38,7 +40,37 @@ class WeightsComputedWarning(UserWarning):
 
 
 def _meshes_in(folder):
-    return sorted(p for p in folder.iterdir() if p.suffix.lower() in MESH_SUFFIXES and p.is_file())
+    # Everything with a mesh suffix, not only regular files: a FIFO or a folder named
+    # mesh.obj is reported by load_mesh ("expected a regular file") rather than skipped.
+    return [p for p in list_folder(folder) if p.suffix.lower() in MESH_SUFFIXES]
+
+
+def _exists(path):
+    return what_is(path) is not None
+
+
+def _is_dir(path):
+    return what_is(path) == "a folder"
+
+
+def read_manifest(path):
+    """``rig.json`` checked: names as strings, files as relative names, ``up`` y or z."""
+    manifest = read_json(path)
+    if not isinstance(manifest, dict):
+        raise RigFileError(path, f"expected a JSON object, got {type(manifest).__name__}")
+    out = {}
+    for key in ("mesh", "skeleton", "weights"):
+        if manifest.get(key) is not None:
+            out[key] = relative_path(path, manifest[key], repr(key))
+    if "mesh" in manifest and manifest["mesh"] is None:
+        out["mesh"] = None   # a rig without a mesh
+
+    if manifest.get("name") is not None:
+        out["name"] = name(path, manifest["name"], "'name'")
+    for key in ("up", "skeleton_up"):   # the mesh's and the skeleton's (io/frames.py)
+        if manifest.get(key) is not None:
+            out[key] = choice(path, manifest[key], repr(key), UP_AXES)
+    return out
 
 
 def find_rig_files(folder):
@@ -48,19 +80,28 @@ def find_rig_files(folder):
     -------
     dict with ``meshes`` (list of Path), ``skeleton`` (Path), ``weights`` (Path or None),
     ``animations`` (list of Path), ``manifest`` (dict).
+
+    Raises
+    ------
+    RigFileError
+        No mesh or skeleton; several meshes at the top of the folder and no ``rig.json``
+        naming one (the elk layout's ``models/*.obj`` parts are merged, that is the layout);
+        a malformed ``rig.json``; an ``animations`` that is not a folder.
     """
     folder = Path(folder)
-    if not folder.is_dir():
+    if not _is_dir(folder):
         raise RigFileError(folder, "expected a rig folder, got " +
-                           ("a file" if folder.exists() else "nothing (not found)"))
-    manifest = read_json(folder / "rig.json") if (folder / "rig.json").is_file() else {}
-    if not isinstance(manifest, dict):
-        raise RigFileError(folder / "rig.json", "expected a JSON object")
+                           ("a file" if _exists(folder) else "nothing (not found)"))
+    manifest = read_manifest(folder / "rig.json") if _exists(folder / "rig.json") else {}
     if "mesh" in manifest:   # "mesh": null is a rig without a mesh (a BVH skeleton)
         meshes = [] if manifest["mesh"] is None else [folder / manifest["mesh"]]
     else:
-        meshes = _meshes_in(folder) or (
-            _meshes_in(folder / "models") if (folder / "models").is_dir() else [])
+        meshes = _meshes_in(folder)
+        if len(meshes) > 1:
+            raise RigFileError(folder, f"expected one mesh or a rig.json naming one, got "
+                                       f"{len(meshes)}: {', '.join(p.name for p in meshes)}")
+        if not meshes and _is_dir(folder / "models"):
+            meshes = _meshes_in(folder / "models")
     if not meshes and "mesh" not in manifest:
         raise RigFileError(folder, f"expected a mesh file ({', '.join(MESH_SUFFIXES)}) in the "
                                    "folder or in models/, got none")
@@ -68,26 +109,30 @@ def find_rig_files(folder):
         skeleton = folder / manifest["skeleton"]
     else:
         candidates = [folder / "skeleton.json", folder / "skeleton" / "skeleton.json"]
-        skeleton = next((c for c in candidates if c.is_file()), None)
+        skeleton = next((c for c in candidates if _exists(c)), None)
         if skeleton is None:
             raise RigFileError(folder, "expected skeleton.json or skeleton/skeleton.json, got "
                                        "neither")
     weights = folder / manifest.get("weights", "weights.npz")
     anim_dir = folder / "animations"
-    animations = sorted(anim_dir.glob("*.json")) if anim_dir.is_dir() else []
+    animations = []
+    if _exists(anim_dir):
+        if not anim_dir.is_dir():
+            raise RigFileError(anim_dir, "expected a folder of clip files, got a file")
+        animations = [p for p in list_folder(anim_dir) if p.suffix.lower() == ".json"]
     return {"meshes": meshes, "skeleton": skeleton,
-            "weights": weights if meshes and weights.is_file() else None,  # none without a mesh
+            "weights": weights if meshes and _exists(weights) else None,  # none without a mesh
             "animations": animations, "manifest": manifest}
 
 
-def load_rig_folder(folder, weights_method="idw"):
+def load_rig_folder(folder, weights_method=None):
     """Load a rig folder (either layout) into a :class:`Rig`.
 
     Warns :class:`WeightsComputedWarning` when the weights were computed because the folder
     has none, and ``UnknownJointsWarning`` for clips naming joints the skeleton lacks.
     """
     folder = Path(folder)
-    if folder.is_dir():
+    if _is_dir(folder):
         recover_interrupted_save(folder)   # a save killed part-way: finish or undo it
     files = find_rig_files(folder)
     skeleton, meta = load_skeleton(files["skeleton"])
@@ -113,8 +158,9 @@ def load_rig_folder(folder, weights_method="idw"):
         indices, weights = np.zeros((0, 1), dtype=np.int64), np.zeros((0, 1))
     else:
         vertices, faces = read_mesh(weld=True)
-        warnings.warn(f"{folder}: no weights file; computed weights by inverse distance to "
-                      f"the bones ({weights_method})", WeightsComputedWarning, stacklevel=2)
+        method = weights_method or default_method(faces)
+        warnings.warn(f"{folder}: no weights file; computed weights ({method})",
+                      WeightsComputedWarning, stacklevel=2)
     # the elk layout's skeleton may be Z up over a Y-up mesh (rigedit/io/frames.py)
     skeleton, up, frames_note, clip_change = resolve_folder_frames(
         folder, skeleton, meta, vertices, files["manifest"])

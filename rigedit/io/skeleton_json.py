@@ -26,21 +26,39 @@ import numpy as np
 from ..errors import RigFileError
 from ..model.skeleton import Skeleton, topological_order
 from .atomic import write_json
-from .jsonfile import read_json, require
+from .jsonfile import (MAX_MAGNITUDE, boolean, choice, name, optional, read_json, require,
+                       vector)
 
-__all__ = ["load_skeleton", "save_skeleton", "skeleton_from_heads", "skeleton_to_dict"]
+__all__ = ["load_skeleton", "save_skeleton", "skeleton_from_heads", "skeleton_to_dict",
+           "UP_AXES"]
+
+#: The vertical axes a rig may declare.
+UP_AXES = ("y", "z")
 
 
 def _vec(path, joint, key, value, width):
-    arr = np.asarray(value, dtype=object)
+    return vector(path, value, width, repr(key), where=f"joint {joint!r}")
+
+
+def _parent(path, joint, value):
+    # An empty string marks a root in some exports, as null does.
+    if value is None or (isinstance(value, str) and not value):
+        return None
+    return name(path, value, "'parent'", where=f"joint {joint!r}")
+
+
+def _checked(path, build):
+    """Build the skeleton; a structural problem (cycle, unknown parent) or a bind pose that is
+    not finite (scales compounding down a long chain) becomes a ``RigFileError``."""
     try:
-        out = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        out = None
-    if out is None or out.shape != (width,) or not np.all(np.isfinite(out)):
-        raise RigFileError(path, f"joint {joint!r}: expected {key!r} to be {width} numbers, "
-                                 f"got {arr.tolist()!r}")
-    return out
+        skeleton = build()
+    except ValueError as exc:
+        raise RigFileError(path, str(exc)) from None
+    big = np.abs(skeleton.bind_matrices[:, :3, 3]).max()
+    if not (np.all(np.isfinite(skeleton.inverse_bind_matrices)) and big <= 100 * MAX_MAGNITUDE):
+        raise RigFileError(path, "expected a bind pose of finite, invertible joint matrices, "
+                                 "got overflowing or degenerate ones")
+    return skeleton
 
 
 def skeleton_from_heads(names, parent_names, heads, tails=None, deform=None):
@@ -73,28 +91,27 @@ def skeleton_from_heads(names, parent_names, heads, tails=None, deform=None):
 
 def _load_elk(path, data):
     joints = require(path, data, "joints", list)
-    hierarchy = data.get("hierarchy") if isinstance(data.get("hierarchy"), dict) else {}
+    hierarchy = optional(data, "hierarchy", {})
+    if not isinstance(hierarchy, dict):
+        raise RigFileError(path, f"expected 'hierarchy' to be an object {{child: parent}}, got "
+                                 f"{type(hierarchy).__name__}")
     names, parents, heads, tails = [], [], [], []
     for i, j in enumerate(joints):
-        name = require(path, j, "name", str, f" in joint {i}")
-        names.append(name)
+        joint = name(path, require(path, j, "name", str, f" in joint {i}"), "'name'", where=f"joint {i}")
+        names.append(joint)
         # The joint's own "parent" wins; the file's {child: parent} map fills in when absent.
-        parent = j["parent"] if "parent" in j else hierarchy.get(name)
-        if parent is not None and not isinstance(parent, str):
-            raise RigFileError(path, f"joint {name!r}: expected 'parent' to be a name or null, "
-                                     f"got {parent!r}")
-        parents.append(parent)
-        heads.append(_vec(path, name, "head", require(path, j, "head", list, f" in joint {name!r}"), 3))
-        tails.append(_vec(path, name, "tail", j["tail"], 3) if "tail" in j else [np.nan] * 3)
+        parents.append(_parent(path, joint, j["parent"] if "parent" in j
+                               else hierarchy.get(joint)))
+        heads.append(_vec(path, joint, "head", require(path, j, "head", list,
+                                                       f" in joint {joint!r}"), 3))
+        tails.append(_vec(path, joint, "tail", j["tail"], 3) if j.get("tail") is not None
+                     else [np.nan] * 3)
     heads, tails = np.array(heads), np.array(tails)
     # A zero-length bone (the elk's `_rootJoint` at the origin) only carries the rig: it
     # takes no weights, or the belly would be bound to a point on the ground.
     length = np.linalg.norm(tails - heads, axis=1)
     deform = ~(np.isfinite(length) & (length < 1e-9))
-    try:
-        return skeleton_from_heads(names, parents, heads, tails, deform)
-    except ValueError as exc:
-        raise RigFileError(path, str(exc)) from None
+    return _checked(path, lambda: skeleton_from_heads(names, parents, heads, tails, deform))
 
 
 def _bind_matrix(path, joint, value):
@@ -129,25 +146,34 @@ def _load_rigedit(path, data):
     joints = require(path, data, "joints", list)
     names, parents, t, r, s, tails, deform, binds = [], [], [], [], [], [], [], []
     for i, j in enumerate(joints):
-        name = require(path, j, "name", str, f" in joint {i}")
-        names.append(name)
-        parents.append(j.get("parent"))
-        t.append(_vec(path, name, "translation", j.get("translation", [0, 0, 0]), 3))
-        r.append(_vec(path, name, "rotation", j.get("rotation", [0, 0, 0, 1]), 4))
-        s.append(_vec(path, name, "scale", j.get("scale", [1, 1, 1]), 3))
-        tails.append(_vec(path, name, "tail", j["tail"], 3) if "tail" in j else [np.nan] * 3)
-        deform.append(bool(j.get("deform", True)))
-        binds.append(_bind_matrix(path, name, j.get("bind_matrix")))
-    try:
+        joint = name(path, require(path, j, "name", str, f" in joint {i}"), "'name'", where=f"joint {i}")
+        names.append(joint)
+        parents.append(_parent(path, joint, j.get("parent")))
+        t.append(_vec(path, joint, "translation", optional(j, "translation", [0, 0, 0]), 3))
+        r.append(_vec(path, joint, "rotation", optional(j, "rotation", [0, 0, 0, 1]), 4))
+        if np.linalg.norm(r[-1]) < 1e-6:
+            raise RigFileError(path, f"joint {joint!r}: expected 'rotation' to be a unit "
+                                     f"quaternion (x, y, z, w), got {r[-1].tolist()}")
+        s.append(_vec(path, joint, "scale", optional(j, "scale", [1, 1, 1]), 3))
+        if np.any(np.abs(s[-1]) < 1e-6):
+            raise RigFileError(path, f"joint {joint!r}: expected 'scale' without a zero "
+                                     f"component, got {s[-1].tolist()}")
+        tails.append(_vec(path, joint, "tail", j["tail"], 3) if j.get("tail") is not None
+                     else [np.nan] * 3)
+        deform.append(boolean(path, optional(j, "deform", True), "'deform'",
+                              where=f"joint {joint!r}"))
+        binds.append(_bind_matrix(path, joint, j.get("bind_matrix")))
+
+    def build():
         order = topological_order(names, parents)
         pos = {names[k]: i for i, k in enumerate(order)}
         return Skeleton([names[k] for k in order],
-                        [-1 if parents[k] in (None, "") else pos[parents[k]] for k in order],
+                        [-1 if parents[k] is None else pos[parents[k]] for k in order],
                         np.array(t)[order], np.array(r)[order], np.array(s)[order],
                         tails=np.array(tails)[order], deform=np.array(deform)[order],
                         bind_matrices=_bind_pose(t, r, s, parents, names, binds, order))
-    except ValueError as exc:
-        raise RigFileError(path, str(exc)) from None
+
+    return _checked(path, build)
 
 
 def load_skeleton(path):
@@ -166,9 +192,11 @@ def load_skeleton(path):
     joints = require(path, data, "joints", list)
     if not joints:
         raise RigFileError(path, "expected at least one joint, got none")
-    if isinstance(joints[0], dict) and "head" in joints[0]:
-        return _load_elk(path, data), {"format": "elk", "up": str(data.get("up", "z"))}
-    return _load_rigedit(path, data), {"format": "rigedit", "up": str(data.get("up", "y"))}
+    elk = isinstance(joints[0], dict) and "head" in joints[0]
+    up = choice(path, optional(data, "up", "z" if elk else "y"), "'up'", UP_AXES)
+    if elk:
+        return _load_elk(path, data), {"format": "elk", "up": up}
+    return _load_rigedit(path, data), {"format": "rigedit", "up": up}
 
 
 def skeleton_to_dict(skeleton, up="y"):
