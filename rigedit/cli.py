@@ -83,6 +83,32 @@ def _parse_size(text):
     return w, h
 
 
+#: Sane ranges of the numeric options: (low, high, low is allowed). Anything outside, and any
+#: NaN or infinity, is one error line before the rig is even read.
+OPTION_RANGES = {"fps": (0.0, 240.0, False), "duration": (0.0, 3600.0, False),
+                 "angle": (-36000.0, 36000.0, True), "max_influences": (1, 8, True)}
+SIZE_RANGE = (16, 7680)
+
+
+def check_options(args):
+    """``UsageError`` for a numeric option that is not finite or out of its range."""
+    import math
+
+    for key, (lo, hi, closed) in OPTION_RANGES.items():
+        value = getattr(args, key, None)
+        if value is None:
+            continue
+        above_low = lo <= value if closed else lo < value
+        if not (math.isfinite(value) and above_low and value <= hi):
+            raise UsageError(f"--{key.replace('_', '-')}: expected a number in "
+                             f"{'[' if closed else '('}{lo:g}, {hi:g}], got {value:g}")
+    if getattr(args, "size", None) is not None:
+        w, h = _parse_size(args.size)
+        if not (SIZE_RANGE[0] <= w <= SIZE_RANGE[1] and SIZE_RANGE[0] <= h <= SIZE_RANGE[1]):
+            raise UsageError(f"--size: expected each side from {SIZE_RANGE[0]} to "
+                             f"{SIZE_RANGE[1]} pixels, got {w}x{h}")
+
+
 def cmd_render(args):
     from .render.recorder import record_clip
 
@@ -198,6 +224,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     try:
         with interruptible():
+            check_options(args)
             if getattr(args, "output", None) is not None:
                 check_output(args.output, folder_ok=args.func is cmd_export)
             return args.func(args)
@@ -214,6 +241,15 @@ def main(argv=None):
         name = getattr(exc, "filename", None)
         print(f"rigedit: error: {name + ': ' if name else ''}{exc.strerror or exc}",
               file=sys.stderr)
+    except MemoryError:
+        print("rigedit: error: out of memory", file=sys.stderr)
+    except Exception as exc:  # a bug rather than bad input: one line; the traceback on request
+        if os.environ.get("RIGEDIT_DEBUG"):
+            raise
+        said = " ".join(str(exc).split())[:300]
+        print(f"rigedit: internal error: {type(exc).__name__}: {said} (RIGEDIT_DEBUG=1 shows "
+              "the traceback)", file=sys.stderr)
+        return 1
     return EXIT_BAD_INPUT
 
 
