@@ -129,3 +129,24 @@ def test_unexpected_exception_in_a_worker_is_logged_not_printed(editor, cache, q
     assert "(in jobs.py:" in shown and "Traceback" not in shown  # innermost rigedit frame
     assert "1 / 0" in _log(cache)
     assert "Traceback" not in capfd.readouterr().err
+
+
+def test_describe_names_the_innermost_rigedit_frame_on_one_line():
+    from rigedit.ui.errors_hook import describe
+
+    def outer():
+        from rigedit.document import skeleton_with_moved_joint
+
+        skeleton_with_moved_joint(None, 0, [np.nan, 0, 0])
+
+    try:
+        outer()
+    except ValueError:
+        text = describe(*sys.exc_info())
+    assert text.startswith("ValueError: expected a finite joint position, got [nan 0. 0.]")
+    assert text.endswith(", skeleton_with_moved_joint)") and "document.py:" in text
+    try:
+        raise RuntimeError("line one\n  line two" + "x" * 400)
+    except RuntimeError:
+        text = describe(*sys.exc_info())
+    assert "\n" not in text and "line one line two" in text and "..." in text

@@ -73,7 +73,10 @@ def describe(exc_type, exc, tb):
     own = [f for f in frames if os.path.abspath(f.filename).startswith(root)
            or f.filename.endswith("app.py")]
     where = (own or frames or [None])[-1]
-    text = f"{exc_type.__name__}: {exc}" if str(exc) else exc_type.__name__
+    message = " ".join(str(exc).split())  # one line, whatever the exception's text
+    if len(message) > 300:
+        message = message[:297] + "..."
+    text = f"{exc_type.__name__}: {message}" if message else exc_type.__name__
     if where is not None:
         text += f" (in {os.path.basename(where.filename)}:{where.lineno}, {where.name})"
     return text
