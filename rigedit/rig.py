@@ -86,8 +86,14 @@ class Rig:
 
     def bounds(self):
         """(2, 3) min and max corner of the rest mesh; of the joints and bone tails at bind
-        time for a rig without a mesh (a BVH skeleton)."""
+        time for a rig without a mesh (a BVH skeleton). When the mesh was bound elsewhere than
+        the rest pose (glTF files may store it in a frame of its own, CesiumMan's is Z up),
+        the mesh skinned at the rest pose."""
         points = self.vertices
+        sk = self.skeleton
+        if len(points) and not np.allclose(sk.forward(sk.rest_local_matrices()),
+                                           sk.bind_matrices, rtol=0, atol=1e-9):
+            points = self.skin(self.rest_pose())
         if len(points) == 0:
             sk = self.skeleton
             tails = sk.tails[np.all(np.isfinite(sk.tails), axis=1)]

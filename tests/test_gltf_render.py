@@ -36,3 +36,11 @@ def test_cesium_man_shows_its_texture_upright():
         assert scene.mesh_actor.GetTexture() is not None
     finally:
         plotter.close()
+
+
+def test_bounds_of_a_mesh_bound_in_its_own_frame():
+    """CesiumMan's mesh is stored Z up and bound there; its rig stands 1.5 m tall along y."""
+    rig = load_gltf(sample_path("CesiumMan.glb"))
+    lo, hi = rig.bounds()
+    assert 1.4 < rig.height() < 1.6 and hi[2] - lo[2] < 0.6
+    assert np.ptp(rig.vertices[:, 2]) > 1.4          # the stored mesh itself is Z up
