@@ -156,3 +156,10 @@ def test_a_big_binding_loads_the_kernels_in_the_background_and_a_small_one_does_
                           text=True, timeout=400)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.split() == ["True", "True", "True", "True"]
+
+
+@pytest.mark.parametrize("method", ["lbs", "dqs"])
+def test_a_palette_of_the_wrong_size_is_refused(method):
+    binding = random_binding(50, 4, 2, seed=5)
+    with pytest.raises(ValueError):
+        binding.skin(random_palette(6, seed=1), method=method, backend="numba")

@@ -311,6 +311,9 @@ class SkinBinding:
         res = self._output(out)
         if kernels is not None and res.dtype == np.float32 and res.flags.c_contiguous:
             palette = np.ascontiguousarray(palette, dtype=np.float64)
+            if palette.shape != (self.num_joints, 4, 4):  # the kernel writes J rows of _dq
+                raise ValueError(f"expected a palette of shape ({self.num_joints}, 4, 4), got "
+                                 f"{palette.shape}")
             has_scale = not kernels.rigid_dual_quaternions(palette, DQS_RIGID_TOL, self._dq)
             if has_scale:
                 dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
