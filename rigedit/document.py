@@ -363,19 +363,26 @@ def skeleton_with_moved_joint(skeleton, joint, head):
     if not np.all(np.isfinite(head)):
         raise ValueError(f"expected a finite joint position, got {head}")
     sk = skeleton
+    # ``head`` is where the joint shows at rest (the rest pose's forward kinematics). A glTF
+    # mesh may be bound in a frame of its own (bind matrices != rest FK, e.g. a Z-up mesh):
+    # each joint's bind matrix then moves with its rest one through the fixed map
+    # bind_j = inv(D_j) @ rest_j, D_j = rest_j @ inv(bind_j); D is the identity otherwise.
+    rest = sk.forward(sk.rest_local_matrices())
     bind = sk.bind_matrices.copy()
+    d_inv = bind[joint] @ np.linalg.inv(rest[joint])
     old = bind[joint, :3, 3].copy()
-    bind[joint, :3, 3] = head
+    rest[joint, :3, 3] = head
+    bind[joint] = d_inv @ rest[joint]
     rest_t = sk.rest_translation.copy()
     for k in [joint, *sk.children(joint)]:
         p = sk.parents[k]
         # The local translation that puts k at its (new) model position under its parent.
-        rest_t[k] = bind[k, :3, 3] if p < 0 else (np.linalg.inv(bind[p]) @ np.append(
-            bind[k, :3, 3], 1.0))[:3]
-    tails = sk.tails.copy()
+        rest_t[k] = rest[k, :3, 3] if p < 0 else (np.linalg.inv(rest[p]) @ np.append(
+            rest[k, :3, 3], 1.0))[:3]
+    tails = sk.tails.copy()  # tails live in the bind frame
     p = sk.parents[joint]
     if p >= 0 and np.all(np.isfinite(tails[p])) and np.allclose(tails[p], old, atol=1e-9):
-        tails[p] = head
+        tails[p] = bind[joint, :3, 3]
     return Skeleton(list(sk.names), sk.parents.copy(), rest_t, sk.rest_rotation.copy(),
                     sk.rest_scale.copy(), bind_matrices=bind, tails=tails,
                     deform=sk.deform.copy())

@@ -54,3 +54,22 @@ def test_rig_folder_keeps_cubic_spline_tangents(tmp_path):
     np.testing.assert_allclose(b.tangents, a.tangents, atol=1e-9)
     for t in np.linspace(0, 1, 21):
         np.testing.assert_allclose(b.sample(t), a.sample(t), atol=1e-8)
+
+
+def test_moving_a_joint_of_a_mesh_bound_in_its_own_frame():
+    """Edit mode on CesiumMan (bound Z up, shown Y up): the joint lands where it was dragged
+    in the view, every joint keeps its bind-to-rest map, so the skin at rest does not jump."""
+    from rigedit.document import skeleton_with_moved_joint
+
+    rig = load_gltf(sample_path("CesiumMan.glb"))
+    sk = rig.skeleton
+    j = sk.index["Skeleton_arm_joint_L__3_"]
+    rest = sk.forward(sk.rest_local_matrices())
+    head = rest[j, :3, 3] + [0.0, 0.05, 0.0]
+    new = skeleton_with_moved_joint(sk, j, head)
+    new_rest = new.forward(new.rest_local_matrices())
+    np.testing.assert_allclose(new_rest[j, :3, 3], head, atol=1e-12)
+    others = np.arange(len(sk)) != j
+    np.testing.assert_allclose(new_rest[others, :3, 3], rest[others, :3, 3], atol=1e-12)
+    np.testing.assert_allclose(new_rest @ np.linalg.inv(new.bind_matrices),
+                               rest @ np.linalg.inv(sk.bind_matrices), atol=1e-9)
