@@ -159,7 +159,7 @@ def read_mesh(data, mesh_nodes, num_joints, warning):
     """
     meshes = data.gltf.meshes or []
     verts, faces, joints, weights, normals, uvs, prim_of, prim_mat = [], [], [], [], [], [], [], []
-    skipped = set()
+    skipped, morphed = set(), 0
     offset = 0
     for node in mesh_nodes:
         m = data.gltf.nodes[node].mesh
@@ -195,6 +195,7 @@ def read_mesh(data, mesh_nodes, num_joints, warning):
                     raise RigFileError(data.path, f"{where}: expected indices below {n} "
                                                   f"vertices, got {idx.max()}")
             j, w = _influences(data, prim.attributes, n, num_joints, where)
+            morphed += bool(prim.targets)
             nrm = _attr(data, prim.attributes, "NORMAL", where)
             uv = _attr(data, prim.attributes, "TEXCOORD_0", where)
             verts.append(pos)
@@ -209,6 +210,9 @@ def read_mesh(data, mesh_nodes, num_joints, warning):
     if skipped:
         warnings.warn(f"{data.path}: skipped primitives that are not triangles (modes "
                       f"{sorted(skipped)})", warning, stacklevel=3)
+    if morphed:
+        warnings.warn(f"{data.path}: ignored the morph targets of {morphed} primitives "
+                      "(rigedit has none; the base shape is used)", warning, stacklevel=3)
     return _merge(data, verts, faces, joints, weights, normals, uvs, prim_of, prim_mat,
                   warning)
 
