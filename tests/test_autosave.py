@@ -71,14 +71,71 @@ def test_autosave_writes_after_an_edit_and_not_when_nothing_changed(make_editor,
     qtbot.waitUntil(lambda: auto.writes == 3, timeout=5000)
 
 
-def test_autosave_waits_for_the_end_of_a_drag(make_editor):
+def test_autosave_waits_for_the_end_of_a_drag(make_editor, qtbot):
     w = make_editor()
     w.autosave.set_interval(0)
     w.document.set_joint_euler(3, [0, 0, 25])
     w.document.begin_drag()
     assert not w.autosave.tick() and _entries() == []
     w.document.end_drag("Drag")
-    assert w.autosave.tick() and len(_entries()) == 1
+    assert w.autosave.tick()  # started in the background
+    qtbot.waitUntil(lambda: w.autosave.writes == 1, timeout=10000)
+    assert len(_entries()) == 1
+
+
+def test_background_write_keeps_the_state_it_started_from(make_editor, qtbot, monkeypatch):
+    """The timer's write runs in a thread; edits made meanwhile go into the next one, and a
+    save meanwhile leaves no entry behind."""
+    import threading
+
+    from rigedit import recovery
+
+    w = make_editor()
+    auto, doc = w.autosave, w.document
+    auto.set_interval(0)
+    gate, real = threading.Event(), recovery.write_entry
+
+    def slow(*args, **kwargs):
+        gate.wait(10)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(recovery, "write_entry", slow)
+    w.timeline.new_clip("before")  # (a new current clip poses the character from it)
+    doc.set_joint_euler(3, [0, 0, 25])
+    first = doc.pose_snapshot()
+    assert auto.tick() and auto.busy
+    assert not auto.tick()  # one write at a time
+    doc.set_joint_euler(3, [0, 0, 50])  # while it writes
+    w.timeline.rename_clip("after")
+    gate.set()
+    qtbot.waitUntil(lambda: auto.writes == 1, timeout=10000)
+    [entry] = _entries()
+    np.testing.assert_array_equal(np.array(entry.info["pose"]), first)
+    assert entry.info["clip"] == "before"
+    assert auto.tick()
+    qtbot.waitUntil(lambda: auto.writes == 2, timeout=10000)
+    [entry] = _entries()
+    np.testing.assert_array_equal(np.array(entry.info["pose"]), doc.pose_snapshot())
+    assert entry.info["clip"] == "after" and "after" in recovery.read_entry(entry)[0].clips
+    # Saved while a write runs: the save does not wait for it, and the entry goes once the
+    # write is done.
+    gate.clear()
+    doc.set_joint_euler(3, [0, 0, 60])
+    assert auto.tick()
+    doc.mark_saved()
+    assert auto.busy
+    gate.set()
+    qtbot.waitUntil(lambda: not auto.busy, timeout=10000)
+    qtbot.wait(100)  # the thread's signal
+    assert _entries() == [] and auto.writes == 2
+    # Closed while a write runs: the close waits for it and leaves nothing.
+    gate.clear()
+    doc.set_joint_euler(3, [0, 0, 70])
+    assert auto.tick()
+    threading.Timer(0.3, gate.set).start()
+    w.close()
+    assert _entries() == []
+
 
 
 def test_clean_close_leaves_nothing(make_editor, cache):

@@ -486,7 +486,7 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
             self.job.wait(5000)
         self.autosave.stop()
         if not self.keep_recovery:
-            self.autosave.discard()  # a clean close leaves no recovery entry
+            self.autosave.discard(wait=True)  # a clean close leaves no recovery entry
         errors_hook.uninstall(self)
         if self.axes is not None:
             self.axes.remove()
