@@ -296,3 +296,31 @@ def test_every_field_with_a_wrong_value_gives_rig_file_error_or_loads(tmp_path):
                 assert str(out) in str(exc)
                 outcomes["refused"] += 1
     assert outcomes["refused"] > 100 and outcomes["loaded"] > 10
+
+
+@pytest.mark.parametrize("where", ["file", "data-uri"])
+def test_texture_from_an_image_file_or_data_uri(tmp_path, where):
+    import base64
+
+    import imageio.v3 as iio
+
+    b, _ = two_bone()
+    image = np.zeros((4, 8, 3), np.uint8)
+    image[:2, :, 0] = 255                      # top half red, bottom half blue
+    image[2:, :, 2] = 255
+    png = iio.imwrite("<bytes>", image, extension=".png")
+    uri = "tex ture.png" if where == "file" else \
+        "data:image/png;base64," + base64.b64encode(png).decode()
+    if where == "file":
+        (tmp_path / "tex ture.png").write_bytes(png)
+        uri = "tex%20ture.png"
+    prim = b.doc["meshes"][0]["primitives"][0]
+    prim["attributes"]["TEXCOORD_0"] = b.accessor(np.tile([[0.5, 0.25]], (8, 1)), "float32")
+    prim["material"] = 0
+    b.doc.update(images=[{"uri": uri}], textures=[{"source": 0}],
+                 materials=[{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])
+    rig = load_gltf(b.write(tmp_path / "t.gltf", "embedded"))
+    mat = rig.surface.materials[rig.surface.textured_material()]
+    assert mat.texture.shape == (4, 8, 4) and mat.mime == "image/png" and mat.image_bytes == png
+    assert tuple(mat.texture[0, 0]) == (255, 0, 0, 255) and tuple(mat.texture[3, 0]) == (0, 0, 255, 255)
+    np.testing.assert_allclose(rig.surface.uvs, np.tile([[0.5, 0.25]], (8, 1)))

@@ -330,7 +330,9 @@ class GltfData:
         if image.bufferView is not None:
             view, _ = self.view_bytes(image.bufferView, where)
             return bytes(view), image.mimeType
+        data = self.uri_bytes(image.uri, where)
         mime = image.mimeType
-        if mime is None and isinstance(image.uri, str) and image.uri.startswith("data:"):
-            mime = image.uri[5:].split(";")[0].split(",")[0] or None
-        return self.uri_bytes(image.uri, where), mime
+        if mime is None:  # a uri needs no mimeType: tell PNG and JPEG by their signature
+            mime = ("image/png" if data[:8] == b"\x89PNG\r\n\x1a\n" else
+                    "image/jpeg" if data[:3] == b"\xff\xd8\xff" else None)
+        return data, mime
