@@ -61,12 +61,14 @@ def test_slider_drag_is_one_undo_step_and_undo_restores_the_pose(window, axis, e
     rest = doc.pose_snapshot()
     points = window.scene.mesh.points.copy()
     steps = np.linspace(0, end, 6)[1:]
-    seen = []
-    doc.subscribe(lambda event, **_: event == "pose" and seen.append(
-        doc.pose.get_euler(j, degrees=True)[axis]))
+    rest_q = Rotation.from_quat(doc.skeleton.rest_rotation[j])
+    seen = []   # the joint's angle from rest at each pose change during the drag
+    doc.subscribe(lambda event, **_: event == "pose" and seen.append(np.degrees(
+        (rest_q.inv() * Rotation.from_quat(doc.pose.rotation[j])).magnitude())))
     _drag_slider(slider, steps * 10)
-    # the joint followed the handle during the drag, ending where the handle was let go
-    assert len(seen) >= 5
+    # the joint followed the handle step by step, ending where the handle was let go
+    assert len(seen) >= 5 and seen[0] < 0.5 * end
+    assert np.all(np.diff(seen) > 0), seen
     expected = np.zeros(3)
     expected[axis] = slider.value() / 10
     assert abs(expected[axis] - end) < 2.0    # within a pixel's worth of slider units
