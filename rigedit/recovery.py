@@ -88,15 +88,11 @@ def entry_folder(pid=None, window=None):
 
 
 def is_bundled(path):
-    """Whether ``path`` is one of the bundled characters (read-only: never saved over)."""
-    if path is None:
-        return False
-    from . import ASSETS_DIR
+    """Whether ``path`` is one of the bundled characters (read-only: never saved over); the
+    one rule is :func:`rigedit.io.rig_save.is_bundled`."""
+    from .io.rig_save import is_bundled as bundled
 
-    try:
-        return Path(path).resolve().is_relative_to(Path(ASSETS_DIR).resolve())
-    except (OSError, ValueError):
-        return False
+    return path is not None and bundled(path)
 
 
 @dataclass

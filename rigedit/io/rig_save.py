@@ -76,7 +76,10 @@ def is_bundled(path):
 
     package = Path(rigedit.__file__).resolve().parent
     roots = {Path(rigedit.ASSETS_DIR).resolve(), package, package.parent / "assets"}
-    path = Path(path).resolve()
+    try:
+        path = Path(path).resolve()
+    except (OSError, ValueError):   # a name the system refuses: no place of the package
+        return False
     return any(path == root or root in path.parents for root in roots)
 
 
