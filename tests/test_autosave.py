@@ -261,6 +261,11 @@ def test_discard_and_later(make_editor):
     rig = demo_rig()
     a = _stale_entry(rig, rig.rest_pose().as_array(), None, 0.0, None)
     w = make_editor()
+    w.document.set_joint_euler(3, [0, 0, 25])  # unsaved work is never replaced
+    assert autosave.offer_recovery(w, ask=lambda win, e: "recover") is None
+    assert "save or discard the changes" in w.last_error
+    w._last_dialog.close()
+    w.document.undo()
     assert autosave.offer_recovery(w, ask=lambda win, e: "later") is None
     assert [e.folder for e in _entries()] == [a]  # still there for the next start
     assert autosave.offer_recovery(w, ask=lambda win, e: "discard") is None

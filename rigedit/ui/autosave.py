@@ -5,9 +5,10 @@ editor that is no longer running left behind. Where and how entries are written 
 :mod:`rigedit.recovery` (pure); this module holds the timer, the signals and the dialog.
 
 The interval is ``RIGEDIT_AUTOSAVE_SECONDS`` (default 120; 0 turns the timer off, the
-crash and signal saves stay). The timer's writes run in a thread (writing the quadruped's
-folder took 0.5-2 s here, mostly the OBJ text): the UI thread only copies the clips and the
-pose. Crash and signal saves write at once, after any write under way.
+crash and signal saves stay). The timer's writes run in a thread (a bundled character's
+folder takes seconds to write, mostly the OBJ text: ``benchmarks/bench_autosave.py``); the
+UI thread only copies the clips and the pose. Crash and signal saves write at once, after
+any write under way.
 """
 from __future__ import annotations
 
@@ -39,10 +40,7 @@ def _interval_from_env():
 
 
 class Autosave(QtCore.QObject):
-    # (generation, revision written, error message or None), from the writer thread
-    _written_in_thread = QtCore.pyqtSignal(int, int, object)
-
-    """Writes the window's document to this process's recovery entry.
+    """Writes the window's document to this editor's recovery entry.
 
     Parameters
     ----------
@@ -58,6 +56,9 @@ class Autosave(QtCore.QObject):
     writes : int
         Snapshots written so far.
     """
+
+    # (generation, revision written, error message or None), from the writer thread
+    _written_in_thread = QtCore.pyqtSignal(int, int, object)
 
     _windows = 0
 
@@ -246,6 +247,10 @@ def recover(window, entry):
     """Open a recovery entry in ``window`` as an unsaved document (its Save goes to the
     original folder; Save As when there was none or it was a bundled character). The entry
     is removed once this editor's own recovery snapshot holds the work. Returns success."""
+    if window.document.modified:  # never replace unsaved work with other unsaved work
+        window.error("Recover", f"save or discard the changes to {window.document.rig.name} "
+                                f"first, then recover {entry.describe()}")
+        return False
     try:
         rig, pose, clip, time = recovery.read_entry(entry)
     except (RigFileError, ValueError, OSError) as exc:
