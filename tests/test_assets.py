@@ -237,20 +237,17 @@ def foot_slide(rig, clip_name, foot_joints, fps=120, contact=0.012, touch=0.003)
 HOOVES = [f"{p}_hoof_{s}" for p in ("hind", "fore") for s in "LR"]
 
 
-def test_quadruped_walk_hooves_stay_planted(quad):
-    lowest, grounded, frac = foot_slide(quad, "walk", HOOVES)
-    assert lowest < 0.0020, f"hoof slides {lowest * 1000:.2f} mm"      # measured 1.34 mm
-    assert grounded < 0.0036, f"hoof skates {grounded * 1000:.2f} mm"  # measured 2.37 mm
-    for f, x in frac.items():   # duty factor of the walk: measured 0.655-0.669 (built 0.62)
-        assert 0.62 < x < 0.70, (f, x)
-
-
-def test_quadruped_run_hooves_stay_planted(quad):
-    lowest, grounded, frac = foot_slide(quad, "run", HOOVES)
-    assert lowest < 0.0034, f"hoof slides {lowest * 1000:.2f} mm"      # measured 2.24 mm
-    assert grounded < 0.020, f"hoof skates {grounded * 1000:.2f} mm"   # measured 13.36 mm
-    for f, x in frac.items():   # duty factor of the trot: measured 0.452-0.466 (built 0.4)
-        assert 0.42 < x < 0.50, (f, x)
+@pytest.mark.parametrize("clip, max_lowest, max_grounded, duty", [
+    # measured: walk 1.34 mm, 2.37 mm, duty 0.655-0.669 (built 0.62);
+    ("walk", 0.0020, 0.0036, (0.62, 0.70)),
+    # trot: 2.24 mm, 13.36 mm, duty 0.452-0.466 (built 0.4)
+    ("run", 0.0034, 0.020, (0.42, 0.50))])
+def test_quadruped_hooves_stay_planted(quad, clip, max_lowest, max_grounded, duty):
+    lowest, grounded, frac = foot_slide(quad, clip, HOOVES)
+    assert lowest < max_lowest, f"hoof slides {lowest * 1000:.2f} mm"
+    assert grounded < max_grounded, f"hoof skates {grounded * 1000:.2f} mm"
+    for f, x in frac.items():   # each hoof's share of the cycle on the ground
+        assert duty[0] < x < duty[1], (f, x)
 
 
 def test_quadruped_walk_is_four_beat(quad):
