@@ -146,3 +146,12 @@ def test_matrix_to_quaternion_matches_scipy_up_to_sign():
                                  Rotation.identity()])
     q = matrix_to_quaternion(rots.as_matrix())
     assert np.allclose(np.abs(np.einsum("ji,ji->j", q, rots.as_quat())), 1.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("k", [0, 4])
+def test_a_binding_without_vertices_skins_to_nothing(backend, k):
+    binding = SkinBinding(np.zeros((0, 3)), np.zeros((0, k), int), np.zeros((0, k)), 3)
+    palette = np.tile(np.eye(4), (3, 1, 1))
+    for method in ("lbs", "dqs"):
+        assert binding.skin(palette, method=method, backend=backend).shape == (0, 3)

@@ -127,6 +127,8 @@ def dqs_skin(rest, indices, weights, dq, scale=None):
     rest = np.asarray(rest, dtype=np.float64)
     weights = np.asarray(weights, dtype=np.float64)
     indices = np.asarray(indices)
+    if len(rest) == 0:  # a rig without a mesh (a BVH skeleton)
+        return np.zeros((0, 3))
     q = np.asarray(dq, dtype=np.float64)[indices]  # (V, K, 8)
     p = rest
     if scale is not None:
