@@ -167,6 +167,7 @@ def write_entry(rig, pose, clip=None, time=0.0, original_path=None, folder=None)
     """
     from .io.atomic import write_json
     from .io.rig_folder import save_rig_folder
+    from .io.rig_save import loaded_clip_files
 
     folder = Path(folder) if folder is not None else entry_folder()
     folder.mkdir(parents=True, exist_ok=True)
@@ -185,7 +186,10 @@ def write_entry(rig, pose, clip=None, time=0.0, original_path=None, folder=None)
         "saved_at": _time.time(), "name": rig.name,
         "original_path": None if original_path is None else str(original_path),
         "bundled": is_bundled(original_path),
-        "clip": clip, "time": float(time), "pose": pose.tolist()})
+        "clip": clip, "time": float(time), "pose": pose.tolist(),
+        # the original folder's clip files, so that saving the recovered document there
+        # still deletes the files of clips deleted before the crash
+        "clip_files": {n: str(p) for n, p in loaded_clip_files(rig).items()}})
     for old in folder.iterdir():
         if old != snap:
             _remove(old)
@@ -210,6 +214,7 @@ def read_entry(entry):
         When the snapshot is unreadable.
     """
     from .io.rig_folder import load_rig_folder
+    from .io.rig_save import remember_clip_files
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -225,6 +230,10 @@ def read_entry(entry):
     original = info.get("original_path")
     rig.path = None if original is None or info.get("bundled") else Path(original)
     rig.name = str(info.get("name", rig.name))
+    files = info.get("clip_files")
+    if rig.path is not None and isinstance(files, dict) and all(
+            isinstance(v, str) for v in files.values()):
+        remember_clip_files(rig, files)
     clip = info.get("clip")
     return rig, pose, clip if clip in rig.clips else None, float(info.get("time", 0.0))
 

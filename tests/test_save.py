@@ -387,3 +387,24 @@ def test_a_load_waits_for_a_save_in_progress_instead_of_undoing_it(tmp_path):
         stage.rmdir()
     loader.join(10)
     assert outcome == [None]
+
+
+def test_a_clip_deleted_before_a_crash_stays_deleted_when_the_recovery_is_saved(tmp_path):
+    """The recovery entry carries the original folder's clip files (elk layout: rig.json has
+    no record of them), so saving the recovered document over it deletes the deleted one."""
+    import json as _json
+
+    from rigedit import recovery
+
+    folder = write_elk_folder(tmp_path / "elk")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rig = load_rig_folder(folder)
+        rig.clips.clear()
+        snap = recovery.write_entry(rig, np.zeros((len(rig.skeleton), 10)),
+                                    original_path=folder, folder=tmp_path / "entry")
+        info = _json.loads((snap / recovery._INFO).read_text())
+        recovered, *_ = recovery.read_entry(recovery.RecoveryEntry(snap.parent, snap, info))
+    assert recovered.path == folder and recovered.clips == {}
+    save_rig_folder(recovered.path, recovered)
+    assert not (folder / "animations" / "bow.json").exists()
