@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Material", "Surface"]
+__all__ = ["Material", "Surface", "display_texture"]
 
 
 @dataclass(eq=False)
@@ -95,3 +95,72 @@ class Surface:
             if m >= 0 and self.materials[m].texture is not None:
                 return int(m)
         return None
+
+
+def _srgb8(linear_rgba):
+    """(3,) uint8 display colour of a linear base colour factor (gamma 2.2)."""
+    rgb = np.clip(np.asarray(linear_rgba, dtype=np.float64)[:3], 0.0, 1.0) ** (1 / 2.2)
+    return np.round(rgb * 255).astype(np.uint8)
+
+
+def display_texture(surface, num_vertices, max_size=1024):
+    """One texture and per-vertex texture coordinates that show every part of a mesh in its
+    own material, for a renderer that draws the mesh as one actor with one texture.
+
+    Each material in use becomes a tile of an atlas laid side by side: its base colour
+    texture times its base colour factor, or a plain tile of its factor. A vertex's
+    coordinates are its UV moved into its material's tile (wrapped into the tile), or the
+    tile's centre for an untextured one. With one textured material the texture is used as it
+    is (no resampling, UVs unchanged so repeat wrapping stays the renderer's).
+
+    Parameters
+    ----------
+    surface : Surface
+    num_vertices : int
+    max_size : int
+        Largest tile side in an atlas of several materials.
+
+    Returns
+    -------
+    image : (H, W, 4) uint8, rows top to bottom
+    tcoords : (V, 2) float32
+        (s, t) with t pointing up the image (VTK's convention: t = 1 - v).
+    """
+    prim_mat = surface.primitive_material
+    used = sorted({int(m) for m in prim_mat}) if prim_mat is not None and len(prim_mat) else [-1]
+    mats = {m: (surface.materials[m] if m >= 0 else Material(name="default")) for m in used}
+    uvs = surface.uvs
+    if len(used) == 1 and mats[used[0]].texture is not None and uvs is not None:
+        mat = mats[used[0]]
+        tint = _srgb8(mat.base_color).astype(np.float64) / 255.0
+        image = mat.texture.copy()
+        image[..., :3] = np.round(image[..., :3] * tint).astype(np.uint8)
+        return image, np.column_stack([uvs[:, 0], 1.0 - uvs[:, 1]]).astype(np.float32)
+    textured = [mats[m].texture for m in used if mats[m].texture is not None]
+    size = min(max_size, max([max(t.shape[:2]) for t in textured], default=1))
+    tiles = []
+    for m in used:
+        mat = mats[m]
+        tile = np.empty((size, size, 4), np.uint8)
+        tile[..., 3] = 255
+        tile[..., :3] = _srgb8(mat.base_color)
+        if mat.texture is not None:
+            tex = mat.texture
+            rows = (np.arange(size) * tex.shape[0] // size)
+            cols = (np.arange(size) * tex.shape[1] // size)
+            tile[..., :3] = np.round(tex[rows][:, cols, :3] * (tile[..., :3] / 255.0))
+        tiles.append(tile)
+    image = np.concatenate(tiles, axis=1)
+    n = len(used)
+    vertex_mat = (np.asarray(prim_mat)[surface.vertex_primitive] if prim_mat is not None
+                  and len(prim_mat) else np.full(num_vertices, -1))
+    k = np.searchsorted(used, vertex_mat)          # each vertex's tile (``used`` is sorted)
+    has_tex = np.array([mats[m].texture is not None for m in used])[k] & (uvs is not None)
+    s = np.full(num_vertices, 0.5)
+    t = np.full(num_vertices, 0.5)
+    if uvs is not None:
+        # half a texel in from the tile's edges so filtering does not bleed from a neighbour
+        inset = 0.5 / size
+        s[has_tex] = inset + np.mod(uvs[has_tex, 0], 1.0) * (1 - 2 * inset)
+        t[has_tex] = 1.0 - (inset + np.mod(uvs[has_tex, 1], 1.0) * (1 - 2 * inset))
+    return image, np.column_stack([(k + s) / n, t]).astype(np.float32)

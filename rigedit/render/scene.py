@@ -12,6 +12,7 @@ import vtk
 from scipy.spatial.transform import Rotation
 
 from ..model.kinematics import skinning_matrices
+from ..surface import display_texture
 
 __all__ = ["RigScene", "up_vector", "front_vector", "faces_to_vtk", "turn_about",
            "joint_points"]
@@ -56,11 +57,6 @@ def joint_points(rig, model):
         Model matrices of the pose.
     """
     return np.vstack([model[:, :3, 3], rig.posed_tails(model)[1]])
-
-
-def _srgb(linear_rgba):
-    """(3,) display colour of a linear glTF base colour factor (gamma 2.2)."""
-    return np.clip(np.asarray(linear_rgba[:3], dtype=float), 0, 1) ** (1 / 2.2)
 
 
 def faces_to_vtk(faces):
@@ -140,24 +136,15 @@ class RigScene:
 
     # ------------------------------------------------------------------ actors
     def _surface_look(self):
-        """``add_mesh`` colour/texture arguments from the rig's surface: the base colour
-        texture through the UVs where a material has one, else the first material's base
-        colour factor, else rigedit's clay colour."""
+        """``add_mesh`` colour/texture arguments from the rig's surface: its materials as one
+        texture (each part in its own material's texture or base colour, see
+        :func:`rigedit.surface.display_texture`), or rigedit's clay colour without a surface."""
         surf = getattr(self.rig, "surface", None)
         if surf is None:
             return {"color": MESH_COLOR}
-        m = surf.textured_material()
-        if m is not None:
-            # glTF's v runs down the image; VTK's t runs up, and pyvista puts row 0 on top
-            uv = surf.uvs
-            self.mesh.active_texture_coordinates = np.column_stack(
-                [uv[:, 0], 1.0 - uv[:, 1]]).astype(np.float32)
-            mat = surf.materials[m]
-            return {"texture": pv.Texture(mat.texture), "color": _srgb(mat.base_color)}
-        used = [int(i) for i in surf.primitive_material if i >= 0]
-        if used:
-            return {"color": _srgb(surf.materials[used[0]].base_color)}
-        return {"color": MESH_COLOR}
+        image, tcoords = display_texture(surf, self.mesh.n_points)
+        self.mesh.active_texture_coordinates = tcoords
+        return {"texture": pv.Texture(image), "color": "white"}
 
     def _add_bare_skeleton(self, plotter):
         """Joint balls and End-Site tail segments: what a mesh-less rig shows."""
