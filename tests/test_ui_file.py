@@ -168,7 +168,7 @@ def test_open_mesh_and_skeleton_from_the_menu(demo_window, qtbot, tmp_path, monk
     assert rig.skeleton.names == source.skeleton.names
     np.testing.assert_allclose(rig.skeleton.bind_matrices, source.skeleton.bind_matrices,
                                atol=1e-9)
-    idx, w = compute_weights(rig.vertices, rig.skeleton)
+    idx, w = compute_weights(rig.vertices, rig.skeleton, "heat", faces=rig.faces)
     np.testing.assert_array_equal(rig.binding.indices, idx)
     np.testing.assert_allclose(rig.binding.weights, w, rtol=0, atol=1e-14)
     # the view shows the new rig at rest, history starts afresh
@@ -186,34 +186,33 @@ def test_open_mesh_and_skeleton_from_the_menu(demo_window, qtbot, tmp_path, monk
     window._last_dialog.close()
 
 
-def test_export_video_dialog_records_what_it_was_asked(window, qtbot, tmp_path, monkeypatch):
+def _export_video(window, qtbot, fields, browse=False, on_record=None):
+    """File > Export video: fill the dialog's ``fields`` ({name of the widget: text typed}),
+    optionally through Browse, press Record; ``on_record`` is called (from the event loop)
+    once recording has begun. Returns the path the dialog showed."""
     from rigedit.ui.record_dialog import RecordDialog
 
-    doc = window.document
-    clip = doc.clips[doc.current_clip]
-    assert clip.duration >= 1.0
-    out = tmp_path / "clip.gif"
-    _answer(monkeypatch, "getSaveFileName", str(out))
     seen = {}
+
+    def button(dialog, start):
+        return next(b for b in dialog.findChildren(QtWidgets.QPushButton)
+                    if b.text().startswith(start))
 
     def fill():
         dialog = QtWidgets.QApplication.activeModalWidget()
         try:
             assert isinstance(dialog, RecordDialog), dialog
-            browse = next(b for b in dialog.findChildren(QtWidgets.QPushButton)
-                          if b.text().startswith("Browse"))
-            browse.click()
-            seen["path"] = dialog.path_edit.text()
-            for box, text in ((dialog.width_spin, "160"), (dialog.height_spin, "120"),
-                              (dialog.fps_spin, "10"), (dialog.start_spin, "0.2"),
-                              (dialog.end_spin, "0.8")):
+            if browse:
+                button(dialog, "Browse").click()
+            for name, text in fields.items():
+                box = getattr(dialog, name)
                 box.selectAll()
                 qtbot.keyClicks(box, text)
                 qtbot.keyClick(box, QtCore.Qt.Key_Tab)
-            seen["settings"] = dialog.settings()
-            record = next(b for b in dialog.findChildren(QtWidgets.QPushButton)
-                          if b.text() == "Record")
-            record.click()
+            seen["path"] = dialog.path_edit.text()
+            if on_record is not None:
+                QtCore.QTimer.singleShot(0, on_record)
+            button(dialog, "Record").click()
         except BaseException as exc:  # never leave the modal dialog open
             seen["error"] = exc
             dialog.reject()
@@ -221,10 +220,49 @@ def test_export_video_dialog_records_what_it_was_asked(window, qtbot, tmp_path, 
     QtCore.QTimer.singleShot(0, fill)
     menu_action(window, "File", "Export video").trigger()
     assert "error" not in seen, seen.get("error")
-    assert seen["path"] == str(out)
+    return seen["path"]
+
+
+def test_export_video_dialog_records_what_it_was_asked(window, qtbot, tmp_path, monkeypatch):
+    doc = window.document
+    assert doc.clips[doc.current_clip].duration >= 1.0
+    out = tmp_path / "clip.gif"
+    _answer(monkeypatch, "getSaveFileName", str(out))
+    path = _export_video(window, qtbot, {"width_spin": "160", "height_spin": "120",
+                                         "fps_spin": "10", "start_spin": "0.2",
+                                         "end_spin": "0.8"}, browse=True)
+    assert path == str(out)
     assert window.last_error is None
     frames = iio.imread(out, index=None)
     assert frames.shape[:3] == (6, 120, 160)       # 0.2 s to 0.8 s at 10 frames/s
     # it moves (measured 2.1: the head nods in a small part of the frame)
     assert np.abs(frames[-1].astype(int) - frames[0].astype(int)).mean() > 1.2
     assert "Recorded 6 frames" in window.statusBar().currentMessage()
+
+
+def test_export_video_cancel_and_bad_folder(window, qtbot, tmp_path):
+    out = tmp_path / "clip.mp4"
+    out.write_bytes(b"an older video")
+    pressed = []
+
+    def cancel():
+        progress = [d for d in window.findChildren(QtWidgets.QProgressDialog) if d.isVisible()]
+        assert len(progress) == 1, progress
+        button = next(b for b in progress[0].findChildren(QtWidgets.QPushButton)
+                      if b.text() == "Cancel")
+        button.click()
+        pressed.append(progress[0].labelText())
+
+    _export_video(window, qtbot, {"path_edit": str(out), "width_spin": "96",
+                                  "height_spin": "64", "fps_spin": "30"}, on_record=cancel)
+    assert pressed and "clip.mp4" in pressed[0]
+    assert out.read_bytes() == b"an older video"          # a cancel keeps the existing file
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["clip.mp4"]  # and no temporary
+    assert "cancelled" in window.statusBar().currentMessage()
+    assert window.last_error is None
+    missing = tmp_path / "no such folder" / "clip.gif"
+    _export_video(window, qtbot, {"path_edit": str(missing), "width_spin": "96",
+                                  "height_spin": "64"})
+    assert "no such folder" in window.last_error
+    assert not missing.parent.exists()
+    window._last_dialog.close()
