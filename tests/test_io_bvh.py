@@ -270,3 +270,57 @@ def test_cli_scale_errors(tmp_path, capsys, argv, problem):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and problem in err[0]
+
+
+TWO_ROOTS = """HIERARCHY
+ROOT a
+{
+  OFFSET 0 0 0
+  CHANNELS 3 Xposition Yposition Zposition
+  JOINT a1
+  {
+    OFFSET 0 10 0
+    CHANNELS 0
+    End Site
+    {
+      OFFSET 0 5 0
+    }
+  }
+}
+ROOT b
+{
+  OFFSET 50 0 0
+  CHANNELS 1 Yrotation
+  End Site
+  {
+    OFFSET 10 0 0
+  }
+}
+MOTION
+Frames: 2
+Frame Time: 0.1
+0 0 0 0
+5 0 0 90
+"""
+
+
+def test_several_roots_and_joints_without_channels_round_trip(tmp_path):
+    from rigedit.io.bvh_write import save_bvh
+
+    rig = load_bvh(write(tmp_path, TWO_ROOTS), scale=0.01)
+    sk = rig.skeleton
+    assert list(sk.parents) == [-1, 0, -1]
+    clip = rig.clips["take"]
+    assert set(clip.tracks) == {("a", "translation"), ("b", "rotation")}
+    end = rig.joint_matrices(clip.sample(0.1))
+    np.testing.assert_allclose(end[:, :3, 3], [[.05, 0, 0], [.05, .1, 0], [.5, 0, 0]])
+    # b turned 90 degrees about y: its End Site (10 units along x) now points along -z
+    joints, tails = rig.posed_tails(end)
+    np.testing.assert_allclose(tails[list(joints).index(2)], [.5, 0, -.1], atol=1e-12)
+    out = tmp_path / "out.bvh"
+    save_bvh(rig, out)
+    back = load_bvh(out, scale=0.01)
+    assert back.skeleton.names == sk.names
+    for t in (0.0, 0.1):
+        np.testing.assert_allclose(back.joint_matrices(back.clips["take"].sample(t))[:, :3, 3],
+                                   rig.joint_matrices(clip.sample(t))[:, :3, 3], atol=1e-8)
