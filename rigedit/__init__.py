@@ -53,7 +53,7 @@ def resolve_rig_path(rig=None):
     return Path(rig)
 
 
-def load_rig(rig=None, weights_method="idw", scale=None):
+def load_rig(rig=None, weights_method=None, scale=None):
     """Load a rig: a bundled name (``quadruped``, the default, or ``humanoid``), a rig folder,
     a ``.glb``/``.gltf`` file or a ``.bvh`` file (see :func:`rigedit.io.load.load_rig`).
 

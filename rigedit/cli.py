@@ -23,7 +23,7 @@ class UsageError(Exception):
     """Bad input that is not about a file (an unknown clip, a bad option value)."""
 
 
-def _load(rig_arg, method="idw", scale=None):
+def _load(rig_arg, method=None, scale=None):
     import rigedit
 
     with warnings.catch_warnings(record=True) as caught:
@@ -41,7 +41,8 @@ def cmd_info(args):
     rows = [("name", rig.name), ("path", rig.path), ("vertices", len(rig.vertices)),
             ("faces", len(rig.faces)), ("joints", len(sk)), ("bones", rig.num_bones),
             ("max_influences", rig.binding.indices.shape[1]),
-            ("weights", "computed (idw)" if rig.weights_computed else "from file"),
+            ("weights", f"computed ({rig.weights_method})" if rig.weights_computed
+             else "from file"),
             ("up", rig.up), ("bounds_min", " ".join(f"{v:.4g}" for v in lo)),
             ("bounds_max", " ".join(f"{v:.4g}" for v in hi)),
             ("clips", " ".join(sorted(rig.clips)) or "-")]
@@ -61,17 +62,25 @@ def cmd_list(args):
 
 def cmd_weights(args):
     from .io.weights_npz import save_weights
-    from .model.weights import compute_weights
+    from .model.weights import compute_weights, default_method
 
     if not str(args.output).endswith(".npz"):
         raise UsageError(f"{args.output}: expected an output file name ending in .npz")
     rig = _load(args.rig, scale=args.scale)
     t0 = time.perf_counter()
-    idx, w = compute_weights(rig.vertices, rig.skeleton, args.method, args.max_influences)
+    method = args.method or default_method(rig.faces)
+    res = compute_weights(rig.vertices, rig.skeleton, method, args.max_influences,
+                          faces=rig.faces)
+    idx, w = res
     dt = time.perf_counter() - t0
+    fallback = getattr(res, "fallback", None)
+    if fallback is not None and len(fallback):
+        print(f"rigedit: warning: {len(fallback)} vertices took weights from the nearest "
+              f"bones (parts of the mesh no bone can see)", file=sys.stderr)
     save_weights(args.output, idx, w, rig.skeleton.names)
     print(f"wrote {args.output}: {len(idx)} vertices, {idx.shape[1]} influences, "
-          f"method {args.method}, {dt:.3f} s")
+          f"method {method}, {dt:.3f} s"
+          + (f", {len(fallback)} fallback vertices" if fallback is not None else ""))
     return 0
 
 
@@ -182,7 +191,9 @@ def build_parser():
     s.set_defaults(func=cmd_list)
     s = sub.add_parser("weights", help="compute skinning weights into a .npz file")
     s.add_argument("rig", nargs="?")
-    s.add_argument("--method", default="idw", help="weights method (default idw)")
+    s.add_argument("--method", default=None,
+                   help="weights method: heat (bone heat, the default for a mesh with faces) "
+                        "or idw (inverse distance, the default for a point cloud)")
     s.add_argument("--max-influences", type=int, default=4, metavar="K")
     s.add_argument("-o", "--output", required=True, metavar="FILE.npz")
     _scale_option(s)

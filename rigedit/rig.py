@@ -6,7 +6,7 @@ import numpy as np
 from .model.kinematics import local_to_model, skinning_matrices
 from .model.pose import Pose
 from .model.skinning import SkinBinding
-from .model.weights import compute_weights
+from .model.weights import compute_weights, default_method
 
 __all__ = ["Rig"]
 
@@ -26,14 +26,16 @@ class Rig:
     name : str
     up : {"y", "z"}
         The vertical axis (bundled characters and glTF: y; the elk format: z).
-    weights_method : str
+    weights_method : str, optional
+        How to compute missing weights: ``heat`` (the default for a mesh with faces) or
+        ``idw`` (the default for a point cloud); kept as ``rig.weights_method``.
     surface : rigedit.surface.Surface, optional
         Normals, texture coordinates and materials where the source file had them (glTF);
         None otherwise. Rig folders do not store it yet.
     """
 
     def __init__(self, skeleton, vertices, faces, indices=None, weights=None, clips=None,
-                 name="rig", up="y", weights_method="idw", path=None, surface=None):
+                 name="rig", up="y", weights_method=None, path=None, surface=None):
         self.skeleton = skeleton
         self.vertices = np.asarray(vertices, dtype=np.float64)
         self.faces = np.asarray(faces, dtype=np.int64)
@@ -46,8 +48,10 @@ class Rig:
         self.notes = {}
         self.surface = surface
         self.weights_computed = indices is None
+        self.weights_method = weights_method or default_method(self.faces)
         if indices is None:
-            indices, weights = compute_weights(self.vertices, skeleton, weights_method)
+            indices, weights = compute_weights(self.vertices, skeleton, self.weights_method,
+                                               faces=self.faces)
         self.bind(indices, weights)
 
     # ------------------------------------------------------------------ binding

@@ -20,20 +20,22 @@ STEPS = 200
 
 @pytest.fixture
 def slow_weights(monkeypatch):
-    """Make the "idw" method report progress in STEPS steps of 10 ms before the real work;
-    returns a record of the fractions it reported."""
-    real = weights_module.METHODS["idw"]
+    """Make every weights method report progress in STEPS steps of 10 ms before the real
+    work; returns a record of the fractions it reported."""
     reported = []
 
-    def slow(vertices, skeleton, progress=None, **options):
-        for i in range(STEPS):
-            time.sleep(0.01)
-            if progress is not None:
-                progress(i / STEPS)     # raises when the user cancelled
-            reported.append(i / STEPS)
-        return real(vertices, skeleton, progress=progress, **options)
+    def slowed(real):
+        def slow(vertices, skeleton, progress=None, **options):
+            for i in range(STEPS):
+                time.sleep(0.01)
+                if progress is not None:
+                    progress(i / STEPS)     # raises when the user cancelled
+                reported.append(i / STEPS)
+            return real(vertices, skeleton, progress=progress, **options)
+        return slow
 
-    monkeypatch.setitem(weights_module.METHODS, "idw", slow)
+    for name, real in list(weights_module.METHODS.items()):
+        monkeypatch.setitem(weights_module.METHODS, name, slowed(real))
     return reported
 
 
@@ -53,7 +55,9 @@ def test_recompute_weights_from_the_menu_gives_compute_weights_result(demo_windo
     one[:, 0] = 1.0
     doc.set_weights(np.full_like(rig.binding.indices, first), one, label="Flat weights")
     flat = rig.binding
-    expected_idx, expected_w = compute_weights(rig.vertices, rig.skeleton)
+    expected_idx, expected_w = compute_weights(rig.vertices, rig.skeleton,
+                                               weights_module.default_method(rig.faces),
+                                               faces=rig.faces)
     assert not np.allclose(flat.weights, expected_w)
     menu_action(window, "File", "Recompute weights").trigger()
     assert window.job is not None

@@ -16,7 +16,11 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .skinning_kernels import disabled as _numba_disabled
+
 try:  # numba is optional: the numpy path below is the reference and the fallback
+    if _numba_disabled():  # RIGEDIT_NO_NUMBA=1, as for the skinning kernels
+        raise ImportError
     import numba
 except ImportError:  # pragma: no cover - exercised on machines without numba
     numba = None

@@ -152,7 +152,8 @@ class DragMixin:
             self.status(f"Re-bind cancelled; {name} keeps its rest position")
 
         job = self.run_job(f"Re-binding after moving {name}",
-                           lambda report: weights_in_chunks(vertices, skeleton, report=report),
+                           lambda report: weights_in_chunks(vertices, skeleton, report=report,
+                                                            faces=rig.faces),
                            done, cancelled)
         # Where the move sits in the history: undo from here cancels it.
         self._pending_rebind = (job, d.undo_stack.top, label) if job is not None else None

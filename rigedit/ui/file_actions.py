@@ -93,7 +93,8 @@ class FileActions:
             report(None)
             skeleton, meta = load_skeleton(skeleton_path)
             vertices, faces = load_mesh(mesh_path)
-            indices, weights = weights_in_chunks(vertices, skeleton, report=report)
+            indices, weights = weights_in_chunks(vertices, skeleton, report=report,
+                                                 faces=faces)
             return Rig(skeleton, vertices, faces, indices, weights, name=Path(mesh_path).stem,
                        up=meta["up"])
 
@@ -231,7 +232,8 @@ class FileActions:
 
         return self.w.run_job("Computing weights",
                               lambda report: weights_in_chunks(vertices, skeleton,
-                                                               report=report), done)
+                                                               report=report,
+                                                               faces=rig.faces), done)
 
     def save_screenshot(self, path=None):
         path = path or self._ask_save("Save screenshot", "rigedit.png", "PNG (*.png)")

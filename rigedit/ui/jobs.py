@@ -10,7 +10,7 @@ import threading
 
 from PyQt5 import QtCore
 
-from ..model.weights import compute_weights
+from ..model.weights import compute_weights, default_method
 
 __all__ = ["Cancelled", "Job", "JobsMixin", "weights_in_chunks"]
 
@@ -148,7 +148,7 @@ class JobsMixin:
             self.job.cancel()
 
 
-def weights_in_chunks(vertices, skeleton, method="idw", report=None):
+def weights_in_chunks(vertices, skeleton, method=None, report=None, faces=None):
     """Compute skin weights with progress: ``report(fraction)`` is called after each block
     of vertices, and its :class:`Cancelled` stops the work between blocks.
 
@@ -157,4 +157,5 @@ def weights_in_chunks(vertices, skeleton, method="idw", report=None):
     indices : (V, K) int32
     weights : (V, K) float64
     """
-    return compute_weights(vertices, skeleton, method, progress=report)
+    method = method or default_method(faces)  # heat for a mesh, idw for a point cloud
+    return compute_weights(vertices, skeleton, method, progress=report, faces=faces)
