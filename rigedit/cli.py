@@ -69,14 +69,15 @@ def cmd_weights(args):
     rig = _load(args.rig, scale=args.scale)
     t0 = time.perf_counter()
     method = args.method or default_method(rig.faces)
-    res = compute_weights(rig.vertices, rig.skeleton, method, args.max_influences,
-                          faces=rig.faces)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res = compute_weights(rig.vertices, rig.skeleton, method, args.max_influences,
+                              faces=rig.faces)
     idx, w = res
     dt = time.perf_counter() - t0
+    for warning in caught:  # heat's fallback and skeleton notes: a line each
+        print(f"rigedit: warning: {warning.message}", file=sys.stderr)
     fallback = getattr(res, "fallback", None)
-    if fallback is not None and len(fallback):
-        print(f"rigedit: warning: {len(fallback)} vertices took weights from the nearest "
-              f"bones (parts of the mesh no bone can see)", file=sys.stderr)
     save_weights(args.output, idx, w, rig.skeleton.names)
     print(f"wrote {args.output}: {len(idx)} vertices, {idx.shape[1]} influences, "
           f"method {method}, {dt:.3f} s"

@@ -335,3 +335,31 @@ def test_progress_is_reported_and_a_raise_cancels():
             raise Stop
     with pytest.raises(Stop):
         heat(v, chain_skeleton(3), f, progress=cancel)
+
+
+# ---------------------------------------------------------------------------- wiring
+def test_rig_defaults_to_heat_and_the_cli_prints_the_fallback_count(tmp_path, capsys):
+    from rigedit.cli import main
+    from rigedit.io import load_weights, save_rig_folder
+    from rigedit.rig import Rig
+    v, f = cylinder(height=3.0)
+    verts = np.vstack([v, v + [10.0, 0.21, 0.13]])
+    faces = np.vstack([f, f + len(v)])
+    sk = chain_skeleton(3)
+    rig = heat_rig = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", HeatWeightsWarning)
+        heat_rig = Rig(sk, verts, faces)
+        rig = Rig(sk, verts, np.zeros((0, 3), int))            # a point cloud: idw
+    assert heat_rig.weights_method == "heat" and rig.weights_method == "idw"
+    expected = heat(verts, sk, faces)
+    np.testing.assert_allclose(heat_rig.binding.weights, expected[1], atol=1e-6)
+    save_rig_folder(tmp_path / "two", heat_rig)
+    out = tmp_path / "w.npz"
+    assert main(["weights", str(tmp_path / "two"), "-o", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert "method heat" in captured.out and f"{len(v)} fallback vertices" in captured.out
+    warned = [line for line in captured.err.splitlines() if "no bone can see" in line]
+    assert len(warned) == 1 and warned[0].startswith(f"rigedit: warning: heat weights: {len(v)} ")
+    idx, w = load_weights(out, sk, len(verts))
+    np.testing.assert_array_equal(idx[:, 0], expected[0][:, 0])
