@@ -408,3 +408,32 @@ def test_a_clip_deleted_before_a_crash_stays_deleted_when_the_recovery_is_saved(
     assert recovered.path == folder and recovered.clips == {}
     save_rig_folder(recovered.path, recovered)
     assert not (folder / "animations" / "bow.json").exists()
+
+
+def test_ctrl_c_after_the_commit_point_waits_for_the_new_state(tmp_path, monkeypatch):
+    """SIGINT arriving while the journal is applied is delivered once the folder holds the
+    new state, not in the middle (where only the next load would finish the save)."""
+    from rigedit.io import rig_save
+
+    folder = tmp_path / "r"
+    save_rig_folder(folder, rig_state("A"))
+    real_replace = os.replace
+    sent = []
+
+    def replace(src, dst):
+        if not sent and STAGING in str(src) and STAGING not in str(dst):
+            sent.append(dst)
+            os.kill(os.getpid(), signal.SIGINT)   # Ctrl-C during the first move into place
+        return real_replace(src, dst)
+
+    monkeypatch.setattr(rig_save.os, "replace", replace)
+    with pytest.raises(KeyboardInterrupt):
+        save_rig_folder(folder, rig_state("B"))
+    monkeypatch.undo()
+    assert sent and not (folder / STAGING).exists()
+    assert fingerprint(load(folder)) == fingerprint(load(_ref(tmp_path, "B")))
+
+
+def _ref(tmp_path, which):
+    save_rig_folder(tmp_path / f"ref{which}", rig_state(which))
+    return tmp_path / f"ref{which}"

@@ -32,6 +32,8 @@ import contextlib
 import json
 import os
 import shutil
+import signal
+import threading
 from pathlib import Path, PurePosixPath
 
 from ..animation.clip_names import check_clip_name
@@ -155,13 +157,41 @@ def _save(folder, rig, names, mesh_name):
                    "replace": [*([] if meshless else [mesh_name, "weights.npz"]),
                                "skeleton.json", *clip_paths.values(), "rig.json"],
                    "delete": [f"{ANIMATIONS}/{f}" for f in stale]}
-        write_json(stage / JOURNAL, journal)   # the commit point
     except BaseException:
         _remove_tree(stage)   # nothing of the folder was touched yet
         raise
-    fsync_folder(stage)
-    _apply(folder, journal)
+    # Ctrl-C or SIGTERM from the commit point on waits until the folder holds the new state,
+    # so an interrupted command does not leave the rest of the save to the next load.
+    with _signals_held():
+        try:
+            write_json(stage / JOURNAL, journal)   # the commit point
+        except BaseException:
+            _remove_tree(stage)
+            raise
+        fsync_folder(stage)
+        _apply(folder, journal)
     return clip_paths
+
+
+@contextlib.contextmanager
+def _signals_held():
+    """Hold SIGINT and SIGTERM for the block (main thread only: Python runs signal handlers
+    there) and deliver them, to the handlers the program had, when it ends."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught = []
+    previous = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        if signal.getsignal(sig) is not None:   # None: a handler Python cannot restore
+            previous[sig] = signal.signal(sig, lambda signum, frame: caught.append(signum))
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        for sig in caught:
+            signal.raise_signal(sig)
 
 
 def _remove_tree(path):
