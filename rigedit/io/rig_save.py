@@ -13,6 +13,9 @@ The protocol
    clip files are deleted, the folders are synced.
 4. The journal is deleted, then the staging folder.
 
+From step 2 to the end, SIGINT and SIGTERM are held and delivered afterwards, so an
+interrupted command leaves the new state in place rather than for the next load to finish.
+
 :func:`recover_interrupted_save` (run by ``load_rig_folder`` and at the start of every save)
 finishes what a killed save left: a staging folder with a journal is applied again, which is
 idempotent (a file already moved is no longer staged), so the folder loads as the new state;
