@@ -14,6 +14,11 @@ joints), of:
   and float32 weights, write the float32 output: 56 bytes per vertex) at the memory-copy
   bandwidth measured in the same run (``np.copyto`` of 256 MB, read + write).
 
+A second table gives the best CPU time of the calling thread for the one-thread paths: on a
+machine shared with busy processes, calls longer than a scheduler time slice are preempted
+and their wall time counts the other processes' turns (measured here: 10 ms of CPU for a 1M
+LBS frame that took 34-44 ms of wall time at a load of 13 on 2 cores).
+
 Run: ``.venv/bin/python benchmarks/bench_skinning.py [--repeat-scale S]`` (BLAS pinned to one
 thread). The kernels are compiled (or loaded from numba's cache) before timing.
 """
@@ -39,22 +44,26 @@ BYTES_PER_VERTEX = 12 + 4 * K + 4 * K + 12  # rest, indices, weights, output
 
 
 def timed_ms(fn, repeat):
-    """(median, best) time of one call in ms, after one warm-up call."""
+    """(median wall, best wall, best CPU time of this thread) of one call in ms, after one
+    warm-up call. On a machine shared with other busy processes a call longer than a
+    scheduler time slice (a few ms) is preempted and its wall time counts theirs; the thread's
+    CPU time does not (for the one-thread paths, which run in this thread)."""
     fn()
-    times = []
+    wall, cpu = [], []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.thread_time()
         fn()
-        times.append(time.perf_counter() - t0)
-    return 1e3 * float(np.median(times)), 1e3 * float(np.min(times))
+        cpu.append(time.thread_time() - c0)
+        wall.append(time.perf_counter() - t0)
+    return 1e3 * float(np.median(wall)), 1e3 * float(np.min(wall)), 1e3 * float(np.min(cpu))
 
 
 def bandwidth_gbs(nbytes=256_000_000, repeat=7):
-    """(median, best) read + write bandwidth of np.copyto in GB/s."""
+    """Read + write bandwidth of np.copyto in GB/s from the times of :func:`timed_ms`."""
     a = np.ones(nbytes // 8)
     b = np.empty_like(a)
-    med, best = timed_ms(lambda: np.copyto(b, a), repeat)
-    return 2 * nbytes / (med * 1e-3) / 1e9, 2 * nbytes / (best * 1e-3) / 1e9
+    return tuple(2 * nbytes / (ms * 1e-3) / 1e9 for ms in timed_ms(lambda: np.copyto(b, a),
+                                                                   repeat))
 
 
 def random_palettes(rng, n):
@@ -88,14 +97,17 @@ def main(repeat_scale=1.0):
     bw = bandwidth_gbs()
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cpus, "
           f"numpy {np.__version__}, numba {kernels.numba.__version__}, one BLAS thread")
-    print(f"memory-copy bandwidth: median {bw[0]:.1f} GB/s, best {bw[1]:.1f} GB/s (np.copyto "
-          f"of 256 MB, read + write); floor = {BYTES_PER_VERTEX} bytes/vertex at that rate")
+    print(f"memory-copy bandwidth: median {bw[0]:.1f} GB/s, best {bw[1]:.1f} GB/s, from CPU "
+          f"time {bw[2]:.1f} GB/s (np.copyto of 256 MB, read + write); floor = "
+          f"{BYTES_PER_VERTEX} bytes/vertex at that rate")
     cols = ["floor", "LBS 1t", "LBS 2t", "LBS numpy", "dense ref", "DQS 1t", "DQS 2t",
             "DQS numpy"]
     print("ms per frame, median / best of the run; ratios of the medians (and of the bests)")
     print("random weights (4 non-zero influences):")
     print(f"{'vertices':>9} | " + " | ".join(f"{c:>13}" for c in cols)
           + f" | {'LBS1/floor':>13} | {'DQS1/LBS1':>13}")
+    cpu_cols = ["floor", "LBS 1t", "LBS numpy", "dense ref", "DQS 1t", "DQS numpy"]
+    cpu_rows = []
     cases = [(v, "random") for v in (10_000, 100_000, 1_000_000)]
     cases += [(v, "quadruped") for v in (10_000, 100_000, 1_000_000)]
     for v, kind in cases:
@@ -126,6 +138,8 @@ def main(repeat_scale=1.0):
         assert np.allclose(binding.skin(p0, method="dqs", backend="numba"), ref_dqs, atol=1e-4)
         repeat = max(3, int(repeat_scale * (200 if v <= 10_000 else 60 if v <= 100_000 else 15)))
         row = {"floor": tuple(v * BYTES_PER_VERTEX / (b * 1e9) * 1e3 for b in bw)}
+        binding.threads = None
+        binding.skin(pals[0], backend="numba")  # the output buffer's pages are mapped
         for threads in (1, 2):
             binding.threads = threads
             row[f"LBS {threads}t"] = timed_ms(lambda: binding.skin(palette(), backend="numba"),
@@ -136,11 +150,19 @@ def main(repeat_scale=1.0):
         row["dense ref"] = timed_ms(dense_frame, max(3, repeat // 4))
         row["DQS numpy"] = timed_ms(
             lambda: binding.skin(palette(), method="dqs", backend="numpy"), max(3, repeat // 4))
-        ratios = [tuple(a / b for a, b in zip(row[x], row[y]))
+        ratios = [tuple(a / b for a, b in zip(row[x][:2], row[y][:2]))
                   for x, y in (("LBS 1t", "floor"), ("DQS 1t", "LBS 1t"))]
         print(f"{v:>9,} | " + " | ".join(f"{row[c][0]:>6.3f}/{row[c][1]:<6.3f}" for c in cols)
               + " | " + " | ".join(f"{r[0]:>5.2f} ({r[1]:.2f})".rjust(13) for r in ratios),
               flush=True)
+        cpu_rows.append((v, kind, row))
+    print("\nbest CPU time of the calling thread, ms per frame (one thread only):")
+    print(f"{'vertices':>9} | {'weights':>9} | " + " | ".join(f"{c:>9}" for c in cpu_cols)
+          + f" | {'LBS1/floor':>10} | {'DQS1/LBS1':>9}")
+    for v, kind, row in cpu_rows:
+        print(f"{v:>9,} | {kind:>9} | " + " | ".join(f"{row[c][2]:>9.3f}" for c in cpu_cols)
+              + f" | {row['LBS 1t'][2] / row['floor'][2]:>10.2f}"
+              + f" | {row['DQS 1t'][2] / row['LBS 1t'][2]:>9.2f}")
 
 
 if __name__ == "__main__":
