@@ -26,6 +26,7 @@ DEBIAN_PACKAGES = [
     "libxcb-randr0", "libxcb-render-util0", "libxcb-xinerama0", "libxcb-xfixes0",
     "libxcb-shape0", "libxcb-cursor0", "libxcb-xkb1", "libxrender1", "libxext6", "libsm6",
     "libice6", "libfontconfig1", "libdbus-1-3", "libxt6",
+    "libsuitesparse-dev",  # CHOLMOD for the heat weights' solver (scikit-sparse builds on it)
 ]
 
 
@@ -82,6 +83,13 @@ def ensure_venv(extra):
     # ends). A failure only means the numpy path.
     say("compiling the skinning kernels (once; cached on disk)")
     subprocess.run([str(PY), "-c", "from rigedit.model import skinning_kernels as k; k.load()"],
+                   cwd=ROOT)
+    # CHOLMOD makes the heat weights' solve several times faster; it builds against the
+    # system's SuiteSparse, so it is a separate step whose failure leaves SciPy's SuperLU.
+    if subprocess.run([str(PY), "-m", "pip", "install", "-q", "-e", ".[fast]"],
+                      cwd=ROOT).returncode != 0:
+        say("scikit-sparse did not install: heat weights use SciPy's SuperLU (slower)")
+    subprocess.run([str(PY), "-c", "from rigedit.model import visibility as v; v.warm()"],
                    cwd=ROOT)
     stamp.touch()
 

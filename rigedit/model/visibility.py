@@ -25,7 +25,7 @@ try:  # numba is optional: the numpy path below is the reference and the fallbac
 except ImportError:  # pragma: no cover - exercised on machines without numba
     numba = None
 
-__all__ = ["SurfaceRays", "HAVE_NUMBA"]
+__all__ = ["SurfaceRays", "HAVE_NUMBA", "warm"]
 
 LEAF = 4
 BLOCK = 256
@@ -272,3 +272,11 @@ class SurfaceRays:
         """(N,) bool: the segment crosses the surface strictly between ``t_lo`` and ``t_hi``."""
         return np.isfinite(self.first_hit(origins, ends, skip, t_lo, t_hi, front_only,
                                           any_hit=True))
+
+
+def warm():
+    """Compile (or load from numba's disk cache) the kernels on a tiny mesh, so the first
+    real use does not wait for the compiler (``dev.py`` calls this after installing)."""
+    v = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    f = np.array([[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]])
+    return SurfaceRays(v, f).first_hit([[0.2, 0.2, -1.0]], [[0.2, 0.2, 1.0]])
