@@ -287,6 +287,14 @@ def test_heat_without_faces_is_one_clear_error():
             compute_weights(v, chain_skeleton(3), "heat", faces=faces)
 
 
+def test_no_deforming_joint_is_an_error():
+    v, f = cylinder()
+    sk = chain_skeleton(3)
+    sk.deform[:] = False
+    with pytest.raises(ValueError, match="deforming joint"):
+        heat_weights(v, sk, f)
+
+
 def test_face_index_out_of_range_is_an_error():
     v, f = cylinder()
     f[0, 0] = len(v)

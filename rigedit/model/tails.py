@@ -64,8 +64,10 @@ def deforming_joints(skeleton, vertices, faces):
             along = heads[j] + np.linspace(0.05, 0.95, 10)[:, None] * (heads[kids[0]] - heads[j])
             if _inside_fraction(along, vertices, faces) < 0.5:
                 deform[j] = False
-    if not deform.any():  # better one weighted joint than none: keep the flagged ones
-        deform = skeleton.deform.copy() if skeleton.deform.any() else np.ones(len(deform), bool)
+    if not skeleton.deform.any():
+        raise ValueError("expected at least one deforming joint, got none")
+    if not deform.any():  # the rules above removed every joint: keep the flagged ones
+        deform = skeleton.deform.copy()
     return deform
 
 
