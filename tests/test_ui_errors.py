@@ -150,3 +150,33 @@ def test_describe_names_the_innermost_rigedit_frame_on_one_line():
     except RuntimeError:
         text = describe(*sys.exc_info())
     assert "\n" not in text and "line one line two" in text and "..." in text
+
+
+def test_window_fixture_still_fails_a_test_whose_vtk_callback_raised(tmp_path):
+    """The editor shows a failed gizmo callback instead of warning; the UI tests' window
+    fixture must still fail the test (it checks ``gizmos.errors``)."""
+    import os
+    import subprocess
+    from pathlib import Path
+
+    tests = Path(__file__).resolve().parent
+    (tmp_path / "conftest.py").write_text('pytest_plugins = ["ui_window_fixture"]\n')
+    (tmp_path / "test_broken_callback.py").write_text(
+        "import numpy as np\n\n\n"
+        "def test_drag_with_a_broken_step(window, monkeypatch):\n"
+        "    def broken(j, target):\n"
+        "        raise RuntimeError('boom in drag_step')\n\n"
+        "    monkeypatch.setattr(window, 'drag_step', broken)\n"
+        "    w = window.gizmos.widgets[5]\n"
+        "    w.InvokeEvent('StartInteractionEvent')\n"
+        "    w.SetCenter(*(np.array(w.GetCenter()) + 0.1))\n"
+        "    w.InvokeEvent('InteractionEvent')\n"
+        "    w.InvokeEvent('EndInteractionEvent')\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        [str(tests), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                           "--rootdir", str(tmp_path), str(tmp_path)],
+                          capture_output=True, text=True, timeout=300, env=env, cwd=tmp_path)
+    assert proc.returncode == 1, proc.stdout[-3000:] + proc.stderr[-3000:]
+    assert "exceptions in VTK callbacks" in proc.stdout, proc.stdout[-6000:]
+    assert "boom in drag_step" in proc.stdout
