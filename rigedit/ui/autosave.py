@@ -295,7 +295,11 @@ def confirm_unsaved_changes(window, ask=None):
 
 
 # ---------------------------------------------------------------------- signals
-def install_signal_handlers(app, window, signals=(signal.SIGTERM, signal.SIGINT, signal.SIGHUP)):
+_SIGNALS = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGINT", "SIGHUP")
+                 if hasattr(signal, name))  # no SIGHUP on Windows
+
+
+def install_signal_handlers(app, window, signals=_SIGNALS):
     """On a termination signal, write the recovery snapshot and quit with status
     128 + signal (the entry stays: the next start offers it).
 
