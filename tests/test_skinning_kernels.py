@@ -163,3 +163,11 @@ def test_a_palette_of_the_wrong_size_is_refused(method):
     binding = random_binding(50, 4, 2, seed=5)
     with pytest.raises(ValueError):
         binding.skin(random_palette(6, seed=1), method=method, backend="numba")
+
+
+def test_vector_kernel_refuses_a_palette_it_would_read_past():
+    binding = random_binding(100, 5, 4, seed=1)
+    kernels = skinning_kernels.load()
+    with pytest.raises(ValueError, match="16 floats"):
+        kernels.lbs(binding._rest32, binding._indices32, binding._weights32,
+                    np.zeros((5, 12), np.float32), np.empty((100, 3), np.float32))

@@ -152,12 +152,16 @@ class SkinBinding:
         self._out = np.empty((v, 3), dtype=np.float32)
         self._tmp = np.empty((v, 3), dtype=np.float32)
         # The kernels' inputs: C-contiguous float32 / int32 (the exact compiled signature),
-        # each vertex's influences sorted by decreasing weight (the kernels stop at a zero).
+        # each vertex's influences sorted by decreasing weight and padded with zero weights to
+        # a multiple of 4 (the kernels blend four at a time and skip a group starting at zero),
+        # and the palette as rows of 16 floats (each 4x4 transposed, see skinning_simd).
         order = np.argsort(-self.weights, axis=1, kind="stable")
-        self._indices32 = np.ascontiguousarray(np.take_along_axis(self.indices, order, 1),
-                                               dtype=np.int32)
-        self._weights32 = np.ascontiguousarray(np.take_along_axis(self.weights, order, 1),
-                                               dtype=np.float32)
+        k4 = max(4, -(-k // 4) * 4)
+        self._indices32 = np.zeros((v, k4), dtype=np.int32)
+        self._weights32 = np.zeros((v, k4), dtype=np.float32)
+        self._indices32[:, :k] = np.take_along_axis(self.indices, order, 1)
+        self._weights32[:, :k] = np.take_along_axis(self.weights, order, 1)
+        self._palette16 = np.empty((self.num_joints, 16), dtype=np.float32)
         self._dq = np.empty((self.num_joints, 8), dtype=np.float32)
         self._scale = np.empty((self.num_joints, 9), dtype=np.float32)
         self._rest_normals32 = None  # set by bind_normals
@@ -221,12 +225,13 @@ class SkinBinding:
         if method != "lbs":
             raise ValueError(f"expected a skinning method in {METHODS}, got {method!r}")
         kernels = self._kernels(backend)
-        self._palette[:] = np.asarray(palette)[:, :3, :].reshape(-1, 12)
         res = self._output(out)
         if kernels is not None and res.dtype == np.float32 and res.flags.c_contiguous:
+            self._palette16.reshape(-1, 4, 4)[:] = np.asarray(palette).transpose(0, 2, 1)
             kernels.run("lbs", len(res), self.threads, self._rest32, self._indices32,
-                        self._weights32, self._palette, res)
+                        self._weights32, self._palette16, res)
             return res
+        self._palette[:] = np.asarray(palette)[:, :3, :].reshape(-1, 12)
         blend = self._blend
         w = self.matrix
         if _csr_matvecs is not None:
@@ -278,10 +283,10 @@ class SkinBinding:
         kernels = self._kernels(backend)
         res, nrm = self._out, self._out_normals
         if kernels is not None:
-            self._palette[:] = np.asarray(palette)[:, :3, :].reshape(-1, 12)
+            self._palette16.reshape(-1, 4, 4)[:] = np.asarray(palette).transpose(0, 2, 1)
             kernels.run("lbs_normals", len(res), self.threads, self._rest32,
-                        self._rest_normals32, self._indices32, self._weights32, self._palette,
-                        res, nrm)
+                        self._rest_normals32, self._indices32, self._weights32,
+                        self._palette16, res, nrm)
             return res, nrm
         self.skin(palette, backend="numpy")  # fills self._blend with each vertex's 3x4
         b = self._blend.reshape(-1, 3, 4)

@@ -41,72 +41,82 @@ DISABLE_ENV = "RIGEDIT_NO_NUMBA"
 # assume finite values or approximate divisions and square roots.
 FASTMATH = {"contract", "reassoc", "nsz", "arcp"}
 
-prange = range  # replaced by numba.prange before compiling (numba reads module globals)
+# Replaced before compiling (numba reads module globals): numba.prange, and the vector blends
+# of skinning_simd (which imports numba, so it is imported only then).
+prange = range
+_blend_apply4 = _blend_apply4_normal = _check_groups = None
 
 
-def _blend_py(indices, weights, palette, v):
-    """Vertex ``v``'s blended 3x4 matrix as 12 values, row-major: its influences' rows of the
-    palette weighted and summed. Every kernel here expects each vertex's influences sorted by
-    decreasing weight and stops at the first zero: real characters have 1-2 non-zero
-    influences on average (the bundled ones 1.9 of 4), and the early stop measured 3.5x
-    faster on the quadruped's weights, and no slower with four."""
-    m0 = m1 = m2 = m3 = m4 = m5 = m6 = m7 = m8 = m9 = m10 = m11 = np.float32(0.0)
-    for k in range(indices.shape[1]):
-        w = weights[v, k]
-        if w == 0.0:  # sorted by decreasing weight: the rest are zero too
-            break
-        p = palette[indices[v, k]]
-        m0 += w * p[0]
-        m1 += w * p[1]
-        m2 += w * p[2]
-        m3 += w * p[3]
-        m4 += w * p[4]
-        m5 += w * p[5]
-        m6 += w * p[6]
-        m7 += w * p[7]
-        m8 += w * p[8]
-        m9 += w * p[9]
-        m10 += w * p[10]
-        m11 += w * p[11]
-    return m0, m1, m2, m3, m4, m5, m6, m7, m8, m9, m10, m11
-
-
-def _apply_py(m, rest, v, out):
-    """out[v] = the 3x4 ``m`` (12 values, row-major) applied to the point rest[v]."""
-    x = rest[v, 0]
-    y = rest[v, 1]
-    z = rest[v, 2]
-    out[v, 0] = m[0] * x + m[1] * y + m[2] * z + m[3]
-    out[v, 1] = m[4] * x + m[5] * y + m[6] * z + m[7]
-    out[v, 2] = m[8] * x + m[9] * y + m[10] * z + m[11]
-
-
-_blend = _blend_py  # replaced by their compiled (inlined) forms before compiling the kernels
-_apply = _apply_py
+def _check_groups_py(indices, palette):
+    """The vector blends read 16 floats per palette row and influences four at a time."""
+    if palette.shape[1] != 16 or indices.shape[1] % 4 != 0:
+        raise ValueError("expected palette rows of 16 floats and influences in groups of 4")
 
 
 def _lbs_py(rest, indices, weights, palette, out):
-    """LBS of every vertex: blend the K influences' 3x4 matrices, apply to the rest point.
+    """LBS of every vertex: blend the influences' skinning matrices, apply to the rest point.
 
-    rest (V, 3) f32, indices (V, K) i32, weights (V, K) f32, palette (J, 12) f32 (the top three
-    rows of each skinning matrix, row-major), out (V, 3) f32.
+    rest (V, 3) f32; indices (V, K) i32 and weights (V, K) f32 with K a multiple of 4, each
+    vertex's influences sorted by decreasing weight and padded with zero weights; palette
+    (J, 16) f32, the rows of :mod:`.skinning_simd` (each 4x4 transposed); out (V, 3) f32.
+    Influences go four at a time through one vector blend; a group whose first weight is zero
+    is skipped (real characters have 1-2 non-zero influences on average, the bundled ones 1.9).
     """
+    _check_groups(indices, palette)
+    k_max = indices.shape[1]
     for v in prange(indices.shape[0]):
-        _apply(_blend(indices, weights, palette, v), rest, v, out)
+        x = rest[v, 0]
+        y = rest[v, 1]
+        z = rest[v, 2]
+        a, b, c = _blend_apply4(palette, indices[v, 0], indices[v, 1], indices[v, 2],
+                                indices[v, 3], weights[v, 0], weights[v, 1], weights[v, 2],
+                                weights[v, 3], x, y, z)
+        for g in range(4, k_max, 4):
+            if weights[v, g] == 0.0:  # sorted: the rest are zero too
+                break
+            a2, b2, c2 = _blend_apply4(palette, indices[v, g], indices[v, g + 1],
+                                       indices[v, g + 2], indices[v, g + 3], weights[v, g],
+                                       weights[v, g + 1], weights[v, g + 2], weights[v, g + 3],
+                                       x, y, z)
+            a += a2
+            b += b2
+            c += c2
+        out[v, 0] = a
+        out[v, 1] = b
+        out[v, 2] = c
 
 
 def _lbs_normals_py(rest, rest_normals, indices, weights, palette, out, out_normals):
     """:func:`_lbs_py` plus the normals: the blended 3x3 applied to the rest normal, then
     renormalised (exact for rotations and uniform scale; the usual approximation otherwise)."""
+    _check_groups(indices, palette)
+    k_max = indices.shape[1]
     for v in prange(indices.shape[0]):
-        m = _blend(indices, weights, palette, v)
-        _apply(m, rest, v, out)
+        x = rest[v, 0]
+        y = rest[v, 1]
+        z = rest[v, 2]
         nx = rest_normals[v, 0]
         ny = rest_normals[v, 1]
         nz = rest_normals[v, 2]
-        a = m[0] * nx + m[1] * ny + m[2] * nz
-        b = m[4] * nx + m[5] * ny + m[6] * nz
-        c = m[8] * nx + m[9] * ny + m[10] * nz
+        px, py, pz, a, b, c = _blend_apply4_normal(
+            palette, indices[v, 0], indices[v, 1], indices[v, 2], indices[v, 3], weights[v, 0],
+            weights[v, 1], weights[v, 2], weights[v, 3], x, y, z, nx, ny, nz)
+        for g in range(4, k_max, 4):
+            if weights[v, g] == 0.0:
+                break
+            px2, py2, pz2, a2, b2, c2 = _blend_apply4_normal(
+                palette, indices[v, g], indices[v, g + 1], indices[v, g + 2], indices[v, g + 3],
+                weights[v, g], weights[v, g + 1], weights[v, g + 2], weights[v, g + 3], x, y, z,
+                nx, ny, nz)
+            px += px2
+            py += py2
+            pz += pz2
+            a += a2
+            b += b2
+            c += c2
+        out[v, 0] = px
+        out[v, 1] = py
+        out[v, 2] = pz
         length = np.sqrt(a * a + b * b + c * c)
         inv = np.float32(1.0) / length if length > np.float32(0.0) else np.float32(0.0)
         out_normals[v, 0] = a * inv
@@ -262,10 +272,13 @@ class Kernels:
     """
 
     def __init__(self, numba):
-        global prange, _blend, _apply
+        global prange, _blend_apply4, _blend_apply4_normal, _check_groups
+        from . import skinning_simd
+
         prange = numba.prange
-        _blend = numba.njit(inline="always")(_blend_py)
-        _apply = numba.njit(inline="always")(_apply_py)
+        _check_groups = numba.njit(_check_groups_py)
+        _blend_apply4 = skinning_simd.blend_apply4
+        _blend_apply4_normal = skinning_simd.blend_apply4_normal
         self.max_threads = numba.config.NUMBA_NUM_THREADS
         self._call_lock = threading.Lock()
         f32 = numba.float32[:, ::1]
