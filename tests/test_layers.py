@@ -7,7 +7,7 @@ GUI = ("PyQt5", "pyvista", "pyvistaqt", "vtk", "vtkmodules", "qtpy")
 
 def test_pure_packages_import_no_gui_modules():
     code = ("import sys, rigedit, rigedit.model, rigedit.animation, rigedit.io, rigedit.rig, "
-            "rigedit.cli\n"
+            "rigedit.cli, rigedit.undo, rigedit.recovery\n"
             "import importlib.util\n"
             "if importlib.util.find_spec('rigedit.document'): import rigedit.document\n"
             f"bad = [m for m in sys.modules if m.split('.')[0] in {GUI!r}]\n"
