@@ -9,7 +9,7 @@ import pytest
 from builders import chain_skeleton, cylinder
 from rigedit.model import Skeleton
 from rigedit.model.heat import HeatWeightsWarning, heat_weights
-from rigedit.model.laplacian import clean_faces, cotangent_laplacian, weld
+from rigedit.model.laplacian import clean_faces, cotangent_laplacian, vertex_normals, weld
 from rigedit.model.skinning import dense_weights
 from rigedit.model.tails import deforming_joints
 from rigedit.model.visibility import HAVE_NUMBA, SurfaceRays
@@ -256,7 +256,7 @@ def test_root_carrier_below_the_mesh_and_zero_length_bones_do_not_deform():
     # root at the origin (on the ground, outside the body); helper at hips' place
     local = [[0, 0, 0], [0, 1.2, 0], [0, 0, 0], [0, 0.9, 0]]
     sk = Skeleton(names, [-1, 0, 1, 2], local, tails=[[np.nan] * 3] * 3 + [[0, 2.9, 0]])
-    deform = deforming_joints(sk, v, f)
+    deform = deforming_joints(sk, v, vertex_normals(v, f))
     np.testing.assert_array_equal(deform, [False, False, True, True])
     # hips' only bone (to helper) has zero length; the helper runs hips to chest
     idx, w = heat(v, sk, f)

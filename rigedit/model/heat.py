@@ -254,9 +254,9 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
 
     t0 = time.perf_counter()
     rays = SurfaceRays(wv, wf, use_numba=use_numba)
-    deform = deforming_joints(skeleton, wv, wf)
-    tails = np.full((len(skeleton), 3), np.nan)
-    tails[skeleton.deform] = skeleton.tails[skeleton.deform]
+    normals = lap.vertex_normals(wv, wf, label)
+    deform = deforming_joints(skeleton, wv, normals)
+    tails = skeleton.tails
     starts, ends, owners = bone_segments_with_tails(skeleton, deform, skeleton.tails)
     joints = np.unique(owners)
     dist, seg = _joint_distances(wv, starts, ends, owners, joints)
@@ -276,8 +276,7 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
     t0 = time.perf_counter()
     rank = dist
     if normal_bias:
-        rank = _normal_biased(wv, wf, label, starts, ends, seg, dist)
-    normals = lap.vertex_normals(wv, wf, label)
+        rank = _normal_biased(wv, normals, starts, ends, seg, dist)
 
     def test(verts, cols):
         return _visible(wv, normals, verts, cols, seg, starts, ends, rays, front_only, behind,
@@ -417,10 +416,9 @@ def _visible(wv, normals, verts, joints, seg, starts, ends, rays, front_only, be
     return ok
 
 
-def _normal_biased(wv, wf, label, starts, ends, seg, dist):
+def _normal_biased(wv, normals, starts, ends, seg, dist):
     """Blender's ranking distance ``d / (0.5 (cos + 1.001))``, cos between the vertex
     normal and the direction from the bone to the vertex."""
-    normals = lap.vertex_normals(wv, wf, label)
     out = np.empty_like(dist)
     for j in range(dist.shape[1]):  # per joint column (tens)
         s = seg[:, j]

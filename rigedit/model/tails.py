@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .laplacian import vertex_normals
 
 __all__ = ["deforming_joints", "bone_segments_with_tails", "infer_leaf_tails"]
 
@@ -32,15 +31,16 @@ REACH = 0.8
 MIN_REGION = 3
 
 
-def deforming_joints(skeleton, vertices, faces):
+def deforming_joints(skeleton, vertices, normals):
     """(J,) bool: joints that may take weight.
 
     Parameters
     ----------
     skeleton : Skeleton
     vertices : (V, 3) float64
-    faces : (F, 3) int64
-        The mesh, for the scale of "zero length" and the carrier test.
+    normals : (V, 3) float64
+        Outward vertex normals (:func:`rigedit.model.laplacian.vertex_normals`); the mesh is
+        the scale of "zero length" and the carrier test's judge of inside.
     """
     heads = skeleton.bind_matrices[:, :3, 3]
     lo, hi = vertices.min(axis=0), vertices.max(axis=0)
@@ -62,7 +62,7 @@ def deforming_joints(skeleton, vertices, faces):
         kids = skeleton.children(j)
         if np.linalg.norm(heads[j]) < tiny and len(kids) == 1:
             along = heads[j] + np.linspace(0.05, 0.95, 10)[:, None] * (heads[kids[0]] - heads[j])
-            if _inside_fraction(along, vertices, faces) < 0.5:
+            if _inside_fraction(along, vertices, normals) < 0.5:
                 deform[j] = False
     if not skeleton.deform.any():
         raise ValueError("expected at least one deforming joint, got none")
@@ -71,11 +71,11 @@ def deforming_joints(skeleton, vertices, faces):
     return deform
 
 
-def _inside_fraction(points, vertices, faces):
+def _inside_fraction(points, vertices, normals):
     """Share of ``points`` behind the surface at their nearest vertex (inside the body)."""
-    from scipy.spatial import cKDTree
-    normals = vertex_normals(vertices, faces)
-    _, near = cKDTree(vertices).query(points)
+    # A handful of points: a brute-force nearest vertex beats building a tree.
+    d2 = (np.einsum("vd,vd->v", vertices, vertices)[None, :] - 2.0 * points @ vertices.T)
+    near = d2.argmin(axis=1)
     return float(np.mean(np.einsum("ij,ij->i", points - vertices[near], normals[near]) < 0))
 
 
