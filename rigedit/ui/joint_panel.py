@@ -237,7 +237,8 @@ class JointPanel(QtWidgets.QWidget):
 class InfoPanel(QtWidgets.QWidget):
     """Counts of the rig: vertices, faces, joints, bones, clips; and the selected joint."""
 
-    FIELDS = ("Rig", "Vertices", "Faces", "Joints", "Bones", "Clips", "Selected", "Influences")
+    FIELDS = ("Rig", "Vertices", "Faces", "Joints", "Bones", "Clips", "Selected", "Influences",
+              "Vertex")
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -267,3 +268,13 @@ class InfoPanel(QtWidgets.QWidget):
             return
         count = int((rig.weights[:, joint] > 1e-3).sum())
         self.labels["Selected"].setText(f"{rig.skeleton.names[joint]} ({count:,} vertices)")
+
+    def show_vertex(self, vertex, influences):
+        """A clicked vertex and its influences, ``[(joint name, weight), ...]`` largest first;
+        ``vertex`` None clears it."""
+        lab = self.labels["Vertex"]
+        if vertex is None:
+            lab.setText("-")
+            return
+        lines = [f"#{vertex:,}"] + [f"{name}: {w:.3f}" for name, w in influences]
+        lab.setText("\n".join(lines))

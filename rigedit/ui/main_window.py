@@ -23,6 +23,7 @@ from .menus import MenusMixin
 from .file_actions import FileActions
 from .joint_panel import InfoPanel, JointPanel
 from .jobs import JobsMixin
+from .weight_brush import install_weight_brush
 
 __all__ = ["MainWindow", "default_rig"]
 
@@ -101,6 +102,7 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
         self._build_status_bar()
         self.document.subscribe(self._on_document)
         self._load_scene()
+        self.weight_brush = install_weight_brush(self)  # issue 10: rigedit/ui/weight_brush.py
         self.autosave = Autosave(self)
         self.error_display = errors_hook.ErrorDisplay(self)
         errors_hook.install(self)

@@ -1,0 +1,454 @@
+"""The weight brush: painting the selected joint's skin weights in the weight paint view.
+
+The maths is :mod:`rigedit.model.weight_paint`; this module turns mouse events of the 3D view
+into dabs. A left-button press on the mesh (brush on) starts a stroke, each mouse move paints
+one dab where the mouse ray meets the shown (skinned) surface, and the release makes the whole
+stroke one undo step (:meth:`Document.set_weights`). The brush radius is in screen pixels:
+at each dab it becomes scene units at the depth of the surface point under the mouse, and the
+vertices within that distance of the point are painted with a smooth falloff. A Ctrl+click on
+the mesh paints nothing and shows the nearest vertex's influences in the info panel.
+
+The press, move and release observers sit on the VTK interactor at a priority between the
+axis handles' and the joint spheres' and abort the events they take, so the camera does not
+turn while painting; a press that misses the mesh or lands on a joint sphere goes on to the
+spheres and the camera as before.
+"""
+from __future__ import annotations
+
+import numpy as np
+import vtk
+from PyQt5 import QtCore, QtWidgets
+
+from ..model.weight_paint import (MODES, brush_vertices, joint_column, mirror_vertices, paint,
+                                  paint_mirrored, vertex_adjacency)
+
+__all__ = ["BrushPanel", "WeightBrush", "install_weight_brush"]
+
+CIRCLE_SEGMENTS = 64
+CIRCLE_COLOR = (1.0, 1.0, 1.0)
+CIRCLE_OFF_MESH = (0.6, 0.6, 0.6)
+
+
+class BrushPanel(QtWidgets.QWidget):
+    """The brush's settings in one row (a tool bar shown while the brush is on): mode, radius
+    (pixels), strength, value of ``set``, X-mirror and the lock of the selected joint. Read by
+    :class:`WeightBrush` at each dab.
+
+    Signals
+    -------
+    lock_toggled(bool)   the user locked or unlocked the selected joint
+    """
+
+    lock_toggled = QtCore.pyqtSignal(bool)
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        row = QtWidgets.QHBoxLayout(self)
+        row.setContentsMargins(4, 0, 4, 0)
+
+        def add(label, widget):
+            if label:
+                row.addWidget(QtWidgets.QLabel(label))
+            row.addWidget(widget)
+
+        self.mode_box = QtWidgets.QComboBox()
+        for m in MODES:
+            self.mode_box.addItem(m.capitalize(), m)
+        add(" Brush ", self.mode_box)
+        self.radius_box = QtWidgets.QSpinBox()
+        self.radius_box.setRange(2, 500)
+        self.radius_box.setValue(40)
+        self.radius_box.setSuffix(" px")
+        self.radius_box.setToolTip("Brush radius on screen; it paints the vertices within that "
+                                   "distance of the surface point under the mouse")
+        add(" Radius ", self.radius_box)
+        self.strength_box = self._unit_box(0.2, "How much one dab changes a weight at the "
+                                                "brush centre (0-1); a stroke adds up dabs")
+        add(" Strength ", self.strength_box)
+        self.value_box = self._unit_box(1.0, "The weight Set paints towards")
+        add(" Set value ", self.value_box)
+        self.mirror_box = QtWidgets.QCheckBox("X-mirror")
+        self.mirror_box.setToolTip("Paint the mirror joint on the other side too")
+        add(None, self.mirror_box)
+        self.lock_box = QtWidgets.QCheckBox("Lock selected joint")
+        self.lock_box.setToolTip("A locked joint's weights do not change while other joints "
+                                 "are painted")
+        self.lock_box.toggled.connect(self.lock_toggled)
+        add(None, self.lock_box)
+        self.locked_label = QtWidgets.QLabel("Locked: none")
+        add(None, self.locked_label)
+        hint = QtWidgets.QLabel("  Paints the selected joint; Ctrl+click: a vertex's influences")
+        hint.setStyleSheet("color: #999")
+        add(None, hint)
+        row.addStretch(1)
+
+    @staticmethod
+    def _unit_box(value, tip):
+        box = QtWidgets.QDoubleSpinBox()
+        box.setRange(0.0, 1.0)
+        box.setDecimals(2)
+        box.setSingleStep(0.05)
+        box.setValue(value)
+        box.setToolTip(tip)
+        return box
+
+    @property
+    def mode(self):
+        return self.mode_box.currentData()
+
+    def set_mode(self, mode):
+        self.mode_box.setCurrentIndex(MODES.index(mode))
+
+    def show_lock(self, joint_locked, names):
+        """Reflect the selected joint's lock (signals blocked) and list the locked joints."""
+        self.lock_box.blockSignals(True)
+        self.lock_box.setChecked(bool(joint_locked))
+        self.lock_box.blockSignals(False)
+        self.locked_label.setText("Locked: " + (", ".join(names) if names else "none"))
+
+
+class WeightBrush:
+    """Paints skin weights with the mouse in a :class:`MainWindow`'s 3D view.
+
+    Attributes
+    ----------
+    enabled : bool
+    locked : set of int
+        Joints whose weights painting must not change.
+    stroke : dict or None
+        The stroke under way: working ``indices`` and ``weights`` (V, K) and the ``joint``.
+    """
+
+    PRIORITY = 9.0  # below the axis handles (10), above the joint spheres (0.5) and camera
+
+    def __init__(self, window, panel):
+        self.w = window
+        self.panel = panel
+        self.enabled = False
+        self.locked = set()
+        self.stroke = None
+        self._cache = {}
+        self._last_xy = None
+        self.picker = vtk.vtkCellPicker()
+        self.picker.SetTolerance(0.0)
+        self.picker.PickFromListOn()
+        self._build_circle()
+        iren = window.plotter.iren.interactor
+        self._iren = iren
+        self._observers = [iren.AddObserver(event, self._guard(fn), self.PRIORITY)
+                           for event, fn in (("LeftButtonPressEvent", self._press),
+                                             ("MouseMoveEvent", self._move),
+                                             ("LeftButtonReleaseEvent", self._release))]
+        panel.lock_toggled.connect(self._lock_selected)
+        window.document.subscribe(self._on_document)
+        self._attach()
+
+    # ------------------------------------------------------------------ scene
+    def _build_circle(self):
+        """A 2D polyline actor in display pixels, moved to the mouse at each event."""
+        self.circle = vtk.vtkPolyData()
+        pts = vtk.vtkPoints()
+        pts.SetNumberOfPoints(CIRCLE_SEGMENTS)
+        self.circle.SetPoints(pts)
+        line = vtk.vtkCellArray()
+        line.InsertNextCell(CIRCLE_SEGMENTS + 1)
+        for k in range(CIRCLE_SEGMENTS + 1):
+            line.InsertCellPoint(k % CIRCLE_SEGMENTS)
+        self.circle.SetLines(line)
+        mapper = vtk.vtkPolyDataMapper2D()
+        mapper.SetInputData(self.circle)
+        self.circle_actor = vtk.vtkActor2D()
+        self.circle_actor.SetMapper(mapper)
+        self.circle_actor.GetProperty().SetLineWidth(2.0)
+        self.circle_actor.GetProperty().SetColor(*CIRCLE_COLOR)
+        self.circle_actor.VisibilityOff()
+
+    def _attach(self):
+        """Put the circle into the overlay renderer and pick on the current mesh actor (both
+        are rebuilt when a rig is opened)."""
+        overlay = getattr(self.w, "overlay", None) or self.w.plotter.renderer
+        if not overlay.HasViewProp(self.circle_actor):
+            overlay.AddViewProp(self.circle_actor)
+        self.picker.InitializePickList()
+        if self.w.scene.mesh_actor is not None:
+            self.picker.AddPickList(self.w.scene.mesh_actor)
+        self._cache = {}
+
+    def _on_document(self, event, **info):
+        if event == "rig":
+            self.cancel()
+            self.locked = set()
+            self._attach()
+            self.w.info_panel.show_vertex(None, [])
+            if not self.w.scene.has_mesh:
+                self.set_enabled(False)
+            self._show_lock()
+        elif event == "selection":
+            self._show_lock()
+
+    # ------------------------------------------------------------------ settings
+    def set_enabled(self, on):
+        """Turn the brush on (the weight paint view with it) or off."""
+        on = bool(on) and self.w.scene.has_mesh
+        self.enabled = on
+        action = getattr(self, "action", None)
+        if action is not None and action.isChecked() != on:
+            action.setChecked(on)  # toggled() calls back here with the same value: no loop
+        if on and not self.w._weights_view:
+            self.w.set_weights_view(True)
+        if not on:
+            self.cancel()
+            self.circle_actor.VisibilityOff()
+        self.w.status("Weight brush: drag on the mesh to paint the selected joint; "
+                      "Ctrl+click shows a vertex's influences" if on else "Weight brush off")
+        self.w.request_render()
+
+    def _lock_selected(self, on):
+        j = self.w.document.selection
+        if j is None:
+            self.w.status("Select a joint to lock it")
+        elif on:
+            self.locked.add(j)
+        else:
+            self.locked.discard(j)
+        self._show_lock()
+
+    def _show_lock(self):
+        d = self.w.document
+        names = [d.skeleton.names[j] for j in sorted(self.locked)]
+        self.panel.show_lock(d.selection in self.locked, names)
+
+    # ------------------------------------------------------------------ events
+    def _guard(self, fn):
+        def callback(obj, event):
+            try:
+                if fn(obj):
+                    obj.GetCommand(self._observers[self._EVENTS.index(event)]).SetAbortFlag(1)
+            except Exception:  # noqa: BLE001 - VTK would swallow it; show it
+                self.cancel()
+                self.w.report_exception("Weight brush")
+        return callback
+
+    _EVENTS = ("LeftButtonPressEvent", "MouseMoveEvent", "LeftButtonReleaseEvent")
+
+    def _active(self):
+        return self.enabled and self.w._weights_view and self.w.scene.has_mesh
+
+    def _press(self, iren):
+        """Returns True when the press is the brush's (a stroke or a vertex query)."""
+        x, y = iren.GetEventPosition()
+        if not self.w.scene.has_mesh or self._sphere_under(x, y):
+            return False
+        if iren.GetControlKey():
+            hit = self.pick(x, y)
+            if hit is None:
+                return False
+            self.show_vertex(self.nearest_vertex(hit))
+            return True
+        if not self._active():
+            return False
+        hit = self.pick(x, y)
+        if hit is None:
+            return False
+        d = self.w.document
+        j = d.selection
+        if j is None:
+            self.w.status("Select a joint to paint its weights (click its sphere or name)")
+            return True
+        if j in self.locked:
+            self.w.status(f"{d.skeleton.names[j]} is locked: unlock it to paint it")
+            return True
+        b = d.rig.binding
+        self.stroke = {"joint": j, "indices": b.indices.copy(), "weights": b.weights.copy(),
+                       "rig": d.rig, "binding": b, "dabs": 0}
+        self.dab(hit, x, y)
+        return True
+
+    def _move(self, iren):
+        x, y = iren.GetEventPosition()
+        self._last_xy = (x, y)
+        if self.stroke is None:
+            if self._active():
+                self._show_circle(x, y, self.pick(x, y) is not None)
+            return False
+        hit = self.pick(x, y)
+        if hit is not None:
+            self.dab(hit, x, y)
+        else:
+            self._show_circle(x, y, False)
+        return True
+
+    def _release(self, iren):
+        if self.stroke is None:
+            return False
+        self.finish()
+        return True
+
+    # ------------------------------------------------------------------ picking
+    def pick(self, x, y):
+        """The point of the shown mesh under display pixel (x, y), or None."""
+        ren = self.w.plotter.renderer
+        if self.w.scene.mesh_actor is None or not ren.IsInViewport(int(x), int(y)):
+            return None
+        if not self.picker.Pick(float(x), float(y), 0.0, ren):
+            return None
+        return np.array(self.picker.GetPickPosition())
+
+    def _sphere_under(self, x, y):
+        """Whether a visible joint sphere is under the mouse (the spheres stay clickable)."""
+        g = self.w.gizmos
+        if g is None or not g.visible or not g.widgets:
+            return False
+        origin, d = self.w.axes.ray(x, y)
+        centers = np.array([wd.GetCenter() for wd in g.widgets]) - origin
+        t = centers @ d
+        miss2 = np.einsum("ij,ij->i", centers, centers) - t * t
+        return bool(np.any((miss2 <= g.radius ** 2) & (t > 0)))
+
+    def world_radius(self, point, pixels):
+        """Scene units that ``pixels`` span on screen at the depth of ``point``."""
+        ren = self.w.plotter.renderer
+        ren.SetWorldPoint(*point, 1.0)
+        ren.WorldToDisplay()
+        dx, dy, dz = ren.GetDisplayPoint()
+        ren.SetDisplayPoint(dx + float(pixels), dy, dz)
+        ren.DisplayToWorld()
+        q = np.array(ren.GetWorldPoint())
+        return float(np.linalg.norm(q[:3] / q[3] - point))
+
+    def nearest_vertex(self, point):
+        pts = np.asarray(self.w.scene.mesh.points)
+        return int(np.argmin(np.einsum("ij,ij->i", pts - point, pts - point)))
+
+    def _show_circle(self, x, y, on_mesh):
+        r = self.panel.radius_box.value()
+        a = np.linspace(0.0, 2.0 * np.pi, CIRCLE_SEGMENTS, endpoint=False)
+        pts = self.circle.GetPoints()
+        for k in range(CIRCLE_SEGMENTS):
+            pts.SetPoint(k, x + r * np.cos(a[k]), y + r * np.sin(a[k]), 0.0)
+        pts.Modified()
+        self.circle.Modified()
+        self.circle_actor.GetProperty().SetColor(*(CIRCLE_COLOR if on_mesh else CIRCLE_OFF_MESH))
+        self.circle_actor.VisibilityOn()
+        self.w.request_render()
+
+    # ------------------------------------------------------------------ painting
+    def _rig_cache(self, key, make):
+        rig = self.w.document.rig
+        if self._cache.get("rig") is not rig:
+            self._cache = {"rig": rig}
+        if key not in self._cache:
+            self._cache[key] = make(rig)
+        return self._cache[key]
+
+    def dab(self, point, x, y):
+        """Paint one dab of the stroke at surface ``point`` (mouse at display (x, y))."""
+        s = self.stroke
+        p = self.panel
+        d = self.w.document
+        radius = self.world_radius(point, p.radius_box.value())
+        self._show_circle(x, y, True)
+        if not radius > 0:
+            return
+        verts, factors = brush_vertices(np.asarray(self.w.scene.mesh.points), point, radius)
+        if len(verts) == 0:
+            return
+        j = s["joint"]
+        sk = d.skeleton
+        options = dict(mode=p.mode, strength=p.strength_box.value(), value=p.value_box.value(),
+                       locked=sorted(self.locked), fallback=int(sk.parents[j]))
+        if p.mode == "smooth":
+            options["adjacency"] = self._rig_cache(
+                "adjacency", lambda rig: vertex_adjacency(rig.faces, len(rig.vertices)))
+        args = (s["indices"], s["weights"], len(sk), j, verts, factors)
+        if p.mirror_box.isChecked():
+            axis = d._side_axis()
+            mirror = self._rig_cache(("mirror", axis),
+                                     lambda rig: mirror_vertices(rig.vertices, axis))
+            s["indices"], s["weights"] = paint_mirrored(*args, mirror, d.mirror, **options)
+        else:
+            s["indices"], s["weights"] = paint(*args, **options)
+        s["dabs"] += 1
+        if self.w._weights_view:
+            self.w.scene.show_weights(joint_column(s["indices"], s["weights"], j))
+        self.w.request_render()
+
+    def finish(self):
+        """End the stroke: its change becomes one undo step."""
+        s, self.stroke = self.stroke, None
+        if s is None:
+            return
+        d = self.w.document
+        if d.rig is not s["rig"] or d.rig.binding is not s["binding"]:
+            self.w.status("Stroke dropped: the weights changed while painting")
+            return
+        b = s["binding"]
+        if np.array_equal(s["indices"], b.indices) and np.array_equal(s["weights"], b.weights):
+            return
+        name = d.skeleton.names[s["joint"]]
+        d.set_weights(s["indices"], s["weights"], label=f"Paint {name}")
+        self.w.status(f"Painted {name} ({s['dabs']} dabs); Ctrl+Z undoes the stroke")
+
+    def cancel(self):
+        """Drop a stroke under way (the shown colours go back to the document's)."""
+        if self.stroke is not None:
+            self.stroke = None
+            if self.w._weights_view:
+                self.w._show_weights()
+
+    # ------------------------------------------------------------------ vertex query
+    def show_vertex(self, v):
+        """Show vertex ``v``'s influences (joint names and weights) in the info panel."""
+        rig = self.w.document.rig
+        b = rig.binding
+        order = np.argsort(-b.weights[v])
+        pairs = [(rig.skeleton.names[b.indices[v, k]], float(b.weights[v, k]))
+                 for k in order if b.weights[v, k] > 0]
+        self.w.info_panel.show_vertex(v, pairs)
+        self.w.status(f"Vertex {v}: " + ", ".join(f"{n} {w:.3f}" for n, w in pairs))
+
+    def remove(self):
+        for tag in self._observers:
+            self._iren.RemoveObserver(tag)
+        self._observers = []
+
+
+def install_weight_brush(window):
+    """Add the brush to ``window``: a checkable "Weight brush" action in the View menu and the
+    tool bar, its settings in a tool bar row shown while it is on, and its mouse handling in
+    the 3D view. Returns the :class:`WeightBrush`.
+    """
+    action = QtWidgets.QAction("Weight brush", window)
+    action.setCheckable(True)
+    action.setToolTip("Paint the selected joint's weights on the mesh (turns on the weight "
+                      "paint view)")
+    action.setStatusTip(action.toolTip())
+    panel = BrushPanel()
+    brush = WeightBrush(window, panel)
+    brush.action = action
+    bar = QtWidgets.QToolBar("Weight brush", window)
+    bar.setObjectName("weight-brush")
+    bar.setMovable(False)
+    bar.addWidget(panel)
+    window.addToolBarBreak()
+    window.addToolBar(bar)
+    bar.setVisible(False)
+    brush.toolbar = bar
+    action.toggled.connect(brush.set_enabled)
+    action.toggled.connect(bar.setVisible)
+    action.setEnabled(window.scene.has_mesh)
+    window.document.subscribe(lambda event, **_: event == "rig" and action.setEnabled(
+        window.scene.has_mesh))
+    view = next(a.menu() for a in window.menuBar().actions()
+                if a.text().replace("&", "") == "View")
+    _insert_after(view, window.weights_action, action)
+    tb = getattr(window, "toolbar", None)
+    if tb is not None:
+        _insert_after(tb, window.weights_action, action)
+    return brush
+
+
+def _insert_after(widget, anchor, action):
+    acts = widget.actions()
+    after = acts.index(anchor) + 1
+    widget.insertAction(acts[after] if after < len(acts) else None, action)
