@@ -1,0 +1,149 @@
+"""Calibration poses, body frames and batched rotation helpers for retargeting."""
+from __future__ import annotations
+
+import numpy as np
+
+from .name_map import find_slots
+
+__all__ = ["Calibration", "calibrate", "model_stack", "swing", "unit", "rotations_of"]
+
+
+def unit(v, eps=1e-12):
+    """Unit vectors along the last axis; zero vectors stay zero."""
+    v = np.asarray(v, dtype=np.float64)
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return np.where(n > eps, v / np.maximum(n, eps), 0.0)
+
+
+def swing(a, b):
+    """Smallest rotations taking directions ``a`` to ``b``.
+
+    Parameters
+    ----------
+    a, b : (..., 3) float64
+        Any lengths; a zero vector on either side gives the identity.
+
+    Returns
+    -------
+    R : (..., 3, 3) float64
+    """
+    a, b = unit(a), unit(b)
+    shape = np.broadcast_shapes(a.shape, b.shape)
+    a, b = np.broadcast_to(a, shape), np.broadcast_to(b, shape)
+    v = np.cross(a, b)
+    c = np.sum(a * b, axis=-1)
+    # Nearly opposite: half a turn about an axis perpendicular to a (Rodrigues fails there).
+    opposite = c < -1 + 1e-9
+    if np.any(opposite):
+        perp = np.cross(a, [1.0, 0.0, 0.0])
+        perp = np.where(np.linalg.norm(perp, axis=-1, keepdims=True) < 1e-6,
+                        np.cross(a, [0.0, 1.0, 0.0]), perp)
+        perp = unit(perp)
+        v = np.where(opposite[..., None], perp, v)
+    k = np.zeros(shape[:-1] + (3, 3))
+    k[..., 0, 1], k[..., 0, 2], k[..., 1, 2] = -v[..., 2], v[..., 1], -v[..., 0]
+    k[..., 1, 0], k[..., 2, 0], k[..., 2, 1] = v[..., 2], -v[..., 1], v[..., 0]
+    factor = np.where(opposite, 0.0, 1.0 / np.maximum(1.0 + c, 1e-12))[..., None, None]
+    eye = np.broadcast_to(np.eye(3), k.shape)
+    rot = eye + k + (k @ k) * factor
+    # half turn about the unit axis p: 2 p p^T - I
+    half = 2 * v[..., :, None] * v[..., None, :] - eye
+    rot = np.where(opposite[..., None, None], half, rot)
+    degenerate = (np.linalg.norm(a, axis=-1) == 0) | (np.linalg.norm(b, axis=-1) == 0)
+    return np.where(degenerate[..., None, None], eye, rot)
+
+
+def rotations_of(mats):
+    """(..., 3, 3) rotation parts of (..., 4, 4) matrices, any scale divided out."""
+    lin = mats[..., :3, :3]
+    return lin / np.linalg.norm(lin, axis=-2, keepdims=True)
+
+
+def model_stack(skeleton, clip, times):
+    """Model matrices of a clip at each time.
+
+    Returns
+    -------
+    mats : (F, J, 4, 4) float64
+    """
+    out = np.empty((len(times), len(skeleton), 4, 4))
+    pose = None
+    for f, t in enumerate(times):
+        pose = clip.sample(t, out=pose)
+        skeleton.forward(pose.local_matrices(), out=out[f])
+    return out
+
+
+class Calibration:
+    """A standing pose of a skeleton with its humanoid slots and body frame.
+
+    Attributes
+    ----------
+    mats : (J, 4, 4) float64
+        Model matrices of the pose.
+    points : (J, 3) float64
+    slots, chains, forward
+        See :func:`rigedit.rigging.name_map.find_slots`.
+    source : str
+        ``"rest"`` or ``"frame 0 of <clip>"``.
+    up, left : (3,) float64
+        Unit body axes: hips to chest, and from the right limbs to the left ones.
+    floor : float
+        Lowest foot point (feet, toes and their tails) in the pose, model y.
+    joint_floor : float
+        Lowest foot or toe joint in the pose (tails left out, as not every format has them).
+    hip_height : float
+        The hip height of the figure standing straight: thigh, shin and ankle height.
+    """
+
+    def __init__(self, skeleton, mats, source, what):
+        self.skeleton, self.mats, self.source = skeleton, mats, source
+        self.points = mats[:, :3, 3]
+        self.slots, self.chains, self.forward = find_slots(skeleton, self.points, what)
+        p, s = self.points, self.slots
+        self.up = unit(p[s["chest"]] - p[s["hips"]])
+        left = (p[s["thigh_L"]] - p[s["thigh_R"]]) + (p[s["upper_arm_L"]] - p[s["upper_arm_R"]])
+        self.left = unit(left - self.up * np.dot(left, self.up))
+        self.feet = [s[k] for k in ("foot_L", "foot_R", "toe_L", "toe_R") if k in s]
+        self.floor = float(self.foot_points(mats[None])[0, :, 1].min())
+        self.joint_floor = float(p[self.feet, 1].min())
+        # Standing hip height: hips above the thigh joints, plus thigh, shin and the lower
+        # ankle's height, so a rest with splayed or bent legs (CMU's) does not shrink it.
+        legs = [p[s["hips"], 1] - p[s[f"thigh_{k}"], 1]
+                + np.linalg.norm(p[s[f"shin_{k}"]] - p[s[f"thigh_{k}"]])
+                + np.linalg.norm(p[s[f"foot_{k}"]] - p[s[f"shin_{k}"]]) for k in "LR"]
+        ankle = min(p[s["foot_L"], 1], p[s["foot_R"], 1]) - self.joint_floor
+        self.hip_height = float(np.mean(legs) + ankle)
+
+    def foot_points(self, mats):
+        """(F, P, 3) model positions of the foot and toe joints (and their tails)."""
+        sk = self.skeleton
+        pts = [mats[:, j, :3, 3] for j in self.feet]
+        for j in self.feet:
+            if np.all(np.isfinite(sk.tails[j])):
+                local = sk.inverse_bind_matrices[j] @ np.r_[sk.tails[j], 1.0]
+                pts.append((mats[:, j] @ local)[:, :3])
+        return np.stack(pts, axis=1)
+
+
+def calibrate(skeleton, clips, what):
+    """The rest pose when it stands like a humanoid, else frame 0 of the first clip that does
+    (a BVH rest may lie all along one axis, as Bandai's does).
+
+    Raises
+    ------
+    ValueError
+        Naming ``what`` and the missing part, when no pose has legs, spine and arms.
+    """
+    rest = skeleton.forward(skeleton.rest_local_matrices())
+    try:
+        return Calibration(skeleton, rest, "rest", what)
+    except ValueError as exc:
+        first = exc
+    for clip in clips:
+        mats = skeleton.forward(clip.sample(0.0).local_matrices())
+        try:
+            return Calibration(skeleton, mats, f"frame 0 of {clip.name}", what)
+        except ValueError:
+            continue
+    raise first

@@ -1,0 +1,325 @@
+"""Humanoid joint maps: canonical slots found from the tree's shape and its joint names.
+
+A humanoid's joints are sorted into *slots*: ``hips``, the spine interior, ``chest`` (where the
+arms branch), ``neck``, ``head`` and per side ``clavicle``, ``upper_arm``, ``forearm``,
+``hand``, ``thigh``, ``shin``, ``foot``, ``toe`` (suffix ``_L`` / ``_R``). Names alone cannot
+do it: CMU's ``LeftShoulder`` is an upper arm where Mixamo's is a clavicle, and CesiumMan
+numbers its arm joints 4, 3, 2. So the limbs are found by structure, in a pose where the figure
+stands (the calibration pose): the hips are the first joint with two chains going down and one
+going up, the chest the first joint up the spine with two side chains; in a limb chain the
+knee (elbow) is the joint named so when exactly one is, otherwise the joint between the two
+longest consecutive segments. Sides come from the names (``L``/``R``/``Left``/``Right``,
+``.L``, ``_l``, prefixes such as ``mixamorig:``) when both chains carry one, otherwise from
+the side of the figure's left (``up x forward``, forward from heel to toe).
+"""
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+
+from ..errors import RigFileError
+
+__all__ = ["normalise_name", "find_slots", "auto_map", "load_map", "save_map",
+           "LIMB_SLOTS"]
+
+LIMB_SLOTS = ("clavicle", "upper_arm", "forearm", "hand", "thigh", "shin", "foot", "toe")
+_NOISE = {"joint", "jnt", "bone", "skeleton", "def", "bip01", "bip001", "mixamorig", "end", "j",
+          "b", "bn", "mch", "org"}
+_SIDES = {"l": "L", "left": "L", "r": "R", "right": "R"}
+_KNEE = {"leg", "lowerleg", "lowleg", "knee", "shin", "calf", "crus"}
+_ELBOW = {"forearm", "lowerarm", "elbow"}
+_HIPS = {"hips", "hip", "pelvis"}
+_BODY_WORDS = ("hand", "foot", "fingers", "finger", "thumb", "hip", "hipjoint", "toe", "arm",
+               "leg", "shoulder", "collar", "upleg", "foreArm")
+
+
+def normalise_name(name):
+    """Split a joint name into a side and a base word.
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    side : {"L", "R", None}
+    base : str
+        Lower case, without namespace (``mixamorig1:``), separators, digits and filler words
+        (``joint``, ``bone``, ``skeleton``...).
+
+    Examples
+    --------
+    >>> normalise_name("mixamorig:LeftForeArm")
+    ('L', 'forearm')
+    >>> normalise_name("leg_joint_R_2")
+    ('R', 'leg')
+    """
+    name = name.split(":")[-1].split("|")[-1]
+    tokens = []
+    for part in re.split(r"[\s_.\-]+", name):
+        # camelCase and a capital side letter glued to a word: "LHipJoint" -> L, Hip, Joint
+        tokens += re.findall(r"[A-Z]+(?=[A-Z][a-z])|[A-Z]?[a-z]+|[A-Z]+|\d+", part)
+    side, words = None, []
+    for tok in tokens:
+        low = tok.lower()
+        if low in _SIDES and side is None:
+            side = _SIDES[low]
+        elif low.isdigit() or low in _NOISE:
+            continue
+        elif side is None and low[0] in "lr" and low[1:] in {w.lower() for w in _BODY_WORDS}:
+            side, words = _SIDES[low[0]], words + [low[1:]]  # CMU's "lhand", "rhand"
+        else:
+            words.append(low)
+    return side, "".join(words)
+
+
+def _subtree_stats(skeleton, points):
+    """Per joint: lowest and highest y, and largest distance from the joint, over its subtree.
+
+    points : (J, 3) joint positions; leaf tails are folded in by the caller via ``points``."""
+    n = len(skeleton)
+    lo, hi = points[:, 1].copy(), points[:, 1].copy()
+    for j in range(n - 1, 0, -1):
+        p = skeleton.parents[j]
+        if p >= 0:
+            lo[p], hi[p] = min(lo[p], lo[j]), max(hi[p], hi[j])
+    return lo, hi
+
+
+def _chain(skeleton, start, score):
+    """Follow the child with the highest ``score`` from ``start`` down to a leaf."""
+    chain = [start]
+    while True:
+        kids = skeleton.children(chain[-1])
+        if len(kids) == 0:
+            return chain
+        chain.append(int(kids[np.argmax(score[kids])]))
+
+
+def _bend_index(skeleton, chain, points, keywords):
+    """Index in ``chain`` of the knee or elbow: the one joint named so, else the joint between
+    the two longest consecutive segments (it needs a joint on each side)."""
+    named = [i for i, j in enumerate(chain) if normalise_name(skeleton.names[j])[1] in keywords]
+    if len(named) == 1 and 1 <= named[0] <= len(chain) - 2:
+        return named[0]
+    if len(chain) < 3:
+        return None
+    seg = np.linalg.norm(np.diff(points[chain], axis=0), axis=1)
+    return int(np.argmax(seg[:-1] + seg[1:])) + 1
+
+
+def find_slots(skeleton, points, what="skeleton"):
+    """Sort a humanoid skeleton's joints into slots.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+    points : (J, 3) float64
+        Model-space joint positions in a standing pose (Y up).
+    what : str
+        How to name the skeleton in errors (a file name).
+
+    Returns
+    -------
+    slots : dict[str, int]
+        Slot name -> joint index (``hips``, ``chest``, ``neck``, ``head``, ``thigh_L``...).
+    chains : dict[str, list[int]]
+        ``spine``: hips to chest inclusive; ``neck``: chest's child up to the head.
+    forward : (3,) float64
+        The figure's horizontal forward direction (heel to toe), unit length.
+
+    Raises
+    ------
+    ValueError
+        When no hips with two legs below and a spine above, or no arms, are found.
+    """
+    points = np.asarray(points, dtype=np.float64)
+    n = len(skeleton)
+    size = float(np.ptp(points, axis=0).max()) or 1.0
+    lo, hi = _subtree_stats(skeleton, points)
+    count = np.ones(n)
+    reach = np.zeros(n)  # furthest distance from each joint within its subtree
+    for j in range(n - 1, 0, -1):
+        p = skeleton.parents[j]
+        if p >= 0:
+            count[p] += count[j]
+    for j in range(n):
+        a = j
+        while a >= 0:
+            reach[a] = max(reach[a], np.linalg.norm(points[j] - points[a]))
+            a = skeleton.parents[a]
+    hips = None
+    for j in range(n):
+        kids = skeleton.children(j)
+        down = [c for c in kids if lo[c] < points[j, 1] - 0.25 * size and count[c] >= 2]
+        up = [c for c in kids if hi[c] > points[j, 1] + 0.15 * size]
+        if len(down) >= 2 and up:
+            hips, legs = j, sorted(down, key=lambda c: lo[c])[:2]
+            spine_start = max(up, key=lambda c: hi[c])
+            break
+    if hips is None:
+        raise ValueError(f"{what}: expected a humanoid with two legs (two joint chains going "
+                         f"down from the hips) and a spine, found no such joint")
+    leg_chains = [_chain(skeleton, c, -lo) for c in legs]
+    slots = {"hips": hips}
+    spine = [hips] + _chain(skeleton, spine_start, hi)
+    chest, arms = None, []
+    for i, j in enumerate(spine[1:], 1):
+        kids = [c for c in skeleton.children(j) if c != (spine[i + 1] if i + 1 < len(spine)
+                                                          else -1)]
+        side = [c for c in kids if count[c] >= 3 and reach[c] > 0.12 * size]
+        if len(side) >= 2:
+            chest, arms = j, sorted(side, key=lambda c: -reach[c])[:2]
+            cut = i
+            break
+    if chest is None:
+        raise ValueError(f"{what}: expected two arms branching from the spine, found none")
+    slots["chest"] = chest
+    chains = {"spine": spine[:cut + 1], "neck": spine[cut + 1:]}
+    neck = chains["neck"]
+    if neck:
+        heads = [j for j in neck if normalise_name(skeleton.names[j])[1] == "head"]
+        head = heads[0] if len(heads) == 1 else neck[-1]
+        chains["neck"] = neck[:neck.index(head) + 1]
+        slots["head"] = head
+        if len(chains["neck"]) >= 2:
+            slots["neck"] = chains["neck"][0]
+    # Forward: from each ankle to its toe (or the foot's end), horizontal.
+    limbs = {}
+    fwd = np.zeros(3)
+    for ch in leg_chains:
+        k = _bend_index(skeleton, ch, points, _KNEE)
+        if k is None or k + 1 >= len(ch):
+            raise ValueError(f"{what}: expected a leg of hip, knee and ankle, got the chain "
+                             f"{[skeleton.names[j] for j in ch]}")
+        part = {"thigh": ch[k - 1], "shin": ch[k], "foot": ch[k + 1]}
+        if k + 2 < len(ch):
+            part["toe"] = ch[k + 2]
+        end = points[ch[-1]] if ch[-1] != ch[k + 1] else points[ch[k + 1]]
+        fwd += (end - points[ch[k + 1]]) * [1, 0, 1]
+        limbs[ch[0]] = part
+    for c in arms:
+        ch = _chain(skeleton, c, reach)
+        k = _bend_index(skeleton, ch, points, _ELBOW)
+        if k is None:
+            raise ValueError(f"{what}: expected an arm of shoulder, elbow and wrist, got the "
+                             f"chain {[skeleton.names[j] for j in ch]}")
+        part = {"upper_arm": ch[k - 1], "forearm": ch[k], "hand": ch[k + 1]}
+        if k >= 2:
+            part["clavicle"] = ch[k - 2]
+        limbs[c] = part
+    if np.linalg.norm(fwd) < 1e-6 * size:
+        fwd = np.array([0.0, 0.0, 1.0])
+    fwd /= np.linalg.norm(fwd)
+    left = np.cross([0.0, 1.0, 0.0], fwd)
+    for pair in (legs, arms):
+        named = [_side_of(skeleton, limbs[c]) for c in pair]
+        if sorted(s for s in named if s) != ["L", "R"]:
+            x = [float(np.dot(points[c] - points[hips], left)) for c in pair]
+            named = ["L", "R"] if x[0] > x[1] else ["R", "L"]
+        for c, s in zip(pair, named):
+            for slot, j in limbs[c].items():
+                slots[f"{slot}_{s}"] = j
+    return slots, chains, fwd
+
+
+def _side_of(skeleton, part):
+    """The side the names of a limb's joints agree on, or None."""
+    sides = {normalise_name(skeleton.names[j])[0] for j in part.values()} - {None}
+    return sides.pop() if len(sides) == 1 else None
+
+
+def _interior_map(src_chain, src_points, tgt_chain, tgt_points):
+    """Pair the interior joints of two chains (ends excluded) by nearest fraction of length,
+    one to one and in order."""
+    def fractions(chain, points):
+        seg = np.linalg.norm(np.diff(points[chain], axis=0), axis=1)
+        total = seg.sum() or 1.0
+        return np.cumsum(seg)[:-1] / total
+    s_in, t_in = src_chain[1:-1], tgt_chain[1:-1]
+    if not s_in or not t_in:
+        return []
+    fs, ft = fractions(src_chain, src_points), fractions(tgt_chain, tgt_points)
+    pairs, used = [], set()
+    for ti in np.argsort(np.abs(ft - 0.5)):  # the middle first: it carries the bend
+        free = [si for si in range(len(s_in)) if si not in used]
+        if not free:
+            break
+        si = min(free, key=lambda s: abs(fs[s] - ft[ti]))
+        # keep the order: no crossing with pairs already made
+        if all((si - a) * (ti - b) > 0 for a, b in pairs):
+            pairs.append((si, ti))
+            used.add(si)
+    return [(s_in[a], t_in[b]) for a, b in sorted(pairs)]
+
+
+def auto_map(src_skeleton, src_points, tgt_skeleton, tgt_points, src_what="source",
+             tgt_what="target"):
+    """The joint map between two humanoids: slot to slot, spine and neck interiors by
+    fraction of length, then any other joints whose normalised names (with side) agree.
+
+    Parameters
+    ----------
+    src_skeleton, tgt_skeleton : Skeleton
+    src_points, tgt_points : (J, 3) float64
+        Joint positions in a standing pose of each.
+
+    Returns
+    -------
+    mapping : dict[str, str]
+        Source joint name -> target joint name.
+    """
+    s_slots, s_chains, _ = find_slots(src_skeleton, src_points, src_what)
+    t_slots, t_chains, _ = find_slots(tgt_skeleton, tgt_points, tgt_what)
+    pairs = [(s_slots[k], t_slots[k]) for k in t_slots if k in s_slots]
+    for name in ("spine", "neck"):
+        pairs += _interior_map(s_chains[name], src_points, t_chains[name], tgt_points)
+    s_used = {a for a, _ in pairs}
+    t_used = {b for _, b in pairs}
+    by_name = {}
+    for j, nm in enumerate(tgt_skeleton.names):
+        if j not in t_used:
+            by_name.setdefault(normalise_name(nm), []).append(j)
+    for j, nm in enumerate(src_skeleton.names):
+        cand = by_name.get(normalise_name(nm), [])
+        if j not in s_used and len(cand) == 1 and normalise_name(nm)[1]:
+            pairs.append((j, cand[0]))
+    return {src_skeleton.names[a]: tgt_skeleton.names[b] for a, b in pairs}
+
+
+def load_map(path, src_skeleton=None, tgt_skeleton=None):
+    """Read a JSON joint map ``{source_joint: target_joint}``; with skeletons, check that every
+    name exists (``RigFileError`` naming the file and the joint)."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            data = json.load(fh)
+    except OSError as exc:
+        raise RigFileError(f"{path}: cannot read the joint map ({exc.strerror})") from None
+    except ValueError as exc:
+        raise RigFileError(f"{path}: expected a JSON joint map, got invalid JSON ({exc})") \
+            from None
+    if isinstance(data, dict) and isinstance(data.get("map"), dict):
+        data = data["map"]
+    if not isinstance(data, dict) or not all(isinstance(k, str) and isinstance(v, str)
+                                             for k, v in data.items()):
+        raise RigFileError(f"{path}: expected an object {{source joint: target joint}} of "
+                           f"names, got {type(data).__name__}")
+    for names, sk, role in ((data.keys(), src_skeleton, "source"),
+                            (data.values(), tgt_skeleton, "target")):
+        if sk is not None:
+            for nm in names:
+                if nm not in sk.index:
+                    raise RigFileError(f"{path}: {role} joint {nm!r} is not in the {role} "
+                                       f"skeleton")
+    if len(set(data.values())) != len(data):
+        raise RigFileError(f"{path}: expected each target joint once, got a repeat")
+    return dict(data)
+
+
+def save_map(path, mapping):
+    """Write a joint map as JSON ``{source joint: target joint}``, atomically."""
+    from ..io.atomic import write_json
+
+    write_json(path, dict(mapping))
