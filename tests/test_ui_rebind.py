@@ -99,6 +99,35 @@ def test_pose_edits_made_while_rebinding_are_kept(window, qtbot, gate):
     window.set_mode("pose")
 
 
+def test_rebind_finishing_during_a_pose_drag_waits_for_its_end(window, qtbot, gate):
+    doc = window.document
+    sk = doc.skeleton
+    j, head = limb_joint(sk), sk.index["head"]
+    s0 = _state(doc)
+    _start_rebind(window, j)
+    window.set_mode("pose")
+    window.chain_length = 1
+    w = window.gizmos.widgets[head]
+    w.InvokeEvent("StartInteractionEvent")
+    w.SetCenter(*(window.gizmos.center(head) + np.array([0.0, 0.0, 0.15]) * doc.rig.height()))
+    w.InvokeEvent("InteractionEvent")
+    gate.set()
+    qtbot.waitUntil(lambda: window.job is None, timeout=30000)
+    qtbot.wait(200)
+    assert doc.skeleton is sk and doc.dragging  # held back while the drag is held
+    w.InvokeEvent("EndInteractionEvent")
+    s1 = (sk, s0[1], doc.pose_snapshot())
+    qtbot.waitUntil(lambda: doc.skeleton is not sk, timeout=5000)
+    s2 = _state(doc)
+    np.testing.assert_array_equal(s2[2][:, 3:], s1[2][:, 3:])  # the drag's rotations kept
+    for expected in (s1, s0):
+        window.undo_action.trigger()
+        _assert_state(doc, expected)
+    for expected in (s1, s2):
+        window.redo_action.trigger()
+        _assert_state(doc, expected)
+
+
 def test_second_rest_move_while_rebinding_is_refused(window, qtbot, gate):
     doc = window.document
     sk = doc.skeleton

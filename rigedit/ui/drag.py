@@ -8,6 +8,7 @@ uses the window's ``document``, ``gizmos``, ``axes``, ``scene``, ``mode``, ``axi
 from __future__ import annotations
 
 import numpy as np
+from PyQt5 import QtCore
 
 from ..document import skeleton_with_moved_joint
 from ..model.ik import drag_joint
@@ -104,7 +105,8 @@ class DragMixin:
         refused with a status message, and the view snaps back).
 
         While it runs the user may keep posing: the finished re-bind keeps the pose the
-        document has then (offset by the rest change), not the one it started from. Undo
+        document has then (offset by the rest change), not the one it started from, and
+        waits for a drag still held to end. Undo
         pressed before any newer edit cancels it (the rest move was the last thing done).
         A result whose rig, skeleton or weights were replaced meanwhile (another rig opened,
         a rest edit redone, weights loaded) is dropped with a status message rather than
@@ -128,6 +130,11 @@ class DragMixin:
             self._pending_rebind = None
             if job.is_cancelled:  # undo cancelled it after the result was on its way
                 cancelled()
+                return
+            if self._interacting or d.dragging:
+                # A pose drag or a slider is held: its undo step starts from the pose under
+                # the old rest, so the rest edit waits for it to end.
+                QtCore.QTimer.singleShot(50, lambda: done(result))
                 return
             if d.rig is not rig or d.skeleton is not base_skeleton \
                     or d.rig.binding is not base_binding:
