@@ -17,7 +17,7 @@ from .errors import RigFileError
 from .model import Pose, Skeleton, SkinBinding
 from .rig import Rig
 
-__all__ = ["load_rig", "save_rig", "resolve_rig_path", "BUNDLED", "ASSETS_DIR", "Rig",
+__all__ = ["load_rig", "save_rig", "retarget", "resolve_rig_path", "BUNDLED", "ASSETS_DIR", "Rig",
            "Skeleton", "Pose", "Clip", "Track", "SkinBinding", "RigFileError"]
 __version__ = "0.1.0"
 
@@ -65,6 +65,14 @@ def load_rig(rig=None, weights_method=None, scale=None):
     from .io.load import load_rig as _load_rig
 
     return _load_rig(rig, weights_method=weights_method, scale=scale)
+
+
+def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_feet=True):
+    """Retarget a clip onto another humanoid (see :func:`rigedit.rigging.retarget`)."""
+    from .rigging.retarget import retarget as _retarget
+
+    return _retarget(source_rig, source_clip, target_rig, map=map, name=name,
+                     clean_feet=clean_feet)
 
 
 def save_rig(rig, path, clips=None):

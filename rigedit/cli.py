@@ -172,6 +172,12 @@ def cmd_export(args):
     return 0
 
 
+def cmd_retarget(args):
+    from .rigging.command import run_retarget
+
+    return run_retarget(args, _load)
+
+
 def _scale_option(s):
     s.add_argument("--scale", type=float, default=None, metavar="M",
                    help="metres per file unit of a .bvh RIG (default: guessed from its height)")
@@ -223,6 +229,17 @@ def build_parser():
                    help="a clip to write (repeat for several; default all, BVH: the first)")
     _scale_option(s)
     s.set_defaults(func=cmd_export)
+    s = sub.add_parser("retarget", help="retarget a motion (BVH, glTF, rig folder) onto a rig")
+    s.add_argument("motion", metavar="MOTION")
+    s.add_argument("--to", required=True, metavar="RIG")
+    s.add_argument("--map", default=None, metavar="MAP.json",
+                   help="joint map {source joint: target joint} (default: found automatically)")
+    s.add_argument("--save-map", default=None, metavar="MAP.json", help="write the map used")
+    s.add_argument("--clip", default=None, metavar="NAME", help="the motion's clip to use")
+    s.add_argument("--name", default=None, metavar="NEW", help="the new clip's name")
+    s.add_argument("-o", "--output", required=True, metavar="FOLDER|OUT.glb|CLIP.json")
+    _scale_option(s)
+    s.set_defaults(func=cmd_retarget)
     return p
 
 
@@ -238,7 +255,7 @@ def main(argv=None):
         with interruptible():
             check_options(args)
             if getattr(args, "output", None) is not None:
-                check_output(args.output, folder_ok=args.func is cmd_export)
+                check_output(args.output, folder_ok=args.func in (cmd_export, cmd_retarget))
             return args.func(args)
     except Interrupted as exc:
         print(f"rigedit: interrupted by {exc}", file=sys.stderr)

@@ -176,6 +176,12 @@ def find_slots(skeleton, points, what="skeleton"):
             break
     if chest is None:
         raise ValueError(f"{what}: expected two arms branching from the spine, found none")
+    rise = points[chest] - points[hips]
+    if rise[1] < 0.7 * np.linalg.norm(rise):  # more than 45 degrees from vertical
+        raise ValueError(f"{what}: expected an upright spine from the hips "
+                         f"({skeleton.names[hips]}) to the chest ({skeleton.names[chest]}), "
+                         f"got one {np.degrees(np.arccos(rise[1] / np.linalg.norm(rise))):.0f} "
+                         f"degrees from vertical (not a standing humanoid)")
     slots["chest"] = chest
     chains = {"spine": spine[:cut + 1], "neck": spine[cut + 1:]}
     neck = chains["neck"]
@@ -296,25 +302,25 @@ def load_map(path, src_skeleton=None, tgt_skeleton=None):
         with open(path, encoding="utf-8") as fh:
             data = json.load(fh)
     except OSError as exc:
-        raise RigFileError(f"{path}: cannot read the joint map ({exc.strerror})") from None
+        raise RigFileError(path, f"cannot read the joint map ({exc.strerror})") from None
     except ValueError as exc:
-        raise RigFileError(f"{path}: expected a JSON joint map, got invalid JSON ({exc})") \
+        raise RigFileError(path, f"expected a JSON joint map, got invalid JSON ({exc})") \
             from None
     if isinstance(data, dict) and isinstance(data.get("map"), dict):
         data = data["map"]
     if not isinstance(data, dict) or not all(isinstance(k, str) and isinstance(v, str)
                                              for k, v in data.items()):
-        raise RigFileError(f"{path}: expected an object {{source joint: target joint}} of "
+        raise RigFileError(path, f"expected an object {{source joint: target joint}} of "
                            f"names, got {type(data).__name__}")
     for names, sk, role in ((data.keys(), src_skeleton, "source"),
                             (data.values(), tgt_skeleton, "target")):
         if sk is not None:
             for nm in names:
                 if nm not in sk.index:
-                    raise RigFileError(f"{path}: {role} joint {nm!r} is not in the {role} "
+                    raise RigFileError(path, f"{role} joint {nm!r} is not in the {role} "
                                        f"skeleton")
     if len(set(data.values())) != len(data):
-        raise RigFileError(f"{path}: expected each target joint once, got a repeat")
+        raise RigFileError(path, "expected each target joint once, got a repeat")
     return dict(data)
 
 

@@ -1,0 +1,64 @@
+"""The work behind ``rigedit retarget`` (the parser entry lives in :mod:`rigedit.cli`)."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from ..errors import RigFileError
+
+__all__ = ["run_retarget"]
+
+
+def _pick_clip(rig, name, path):
+    if name is not None:
+        if name not in rig.clips:
+            raise RigFileError(path, f"no clip {name!r} (clips: {', '.join(sorted(rig.clips))})")
+        return rig.clips[name]
+    if not rig.clips:
+        raise RigFileError(path, "expected a clip to retarget, got none")
+    if len(rig.clips) > 1:
+        raise RigFileError(path, f"several clips ({', '.join(sorted(rig.clips))}); choose "
+                           f"one with --clip")
+    return next(iter(rig.clips.values()))
+
+
+def run_retarget(args, load):
+    """Retarget ``args.motion``'s clip onto ``args.to`` and write ``args.output``.
+
+    ``load(path, scale=...)`` reads a rig (the CLI's loader, which prints warnings)."""
+    from .name_map import load_map, save_map
+    from .retarget import retarget_result
+
+    source = load(args.motion, scale=args.scale)
+    target = load(args.to)
+    clip = _pick_clip(source, args.clip, args.motion)
+    mapping = None
+    if args.map is not None:
+        mapping = load_map(args.map, source.skeleton, target.skeleton)
+    # a skeleton with no legs or arms is a ValueError naming the file: the CLI prints it
+    res = retarget_result(source, clip, target, mapping, args.name,
+                          source_what=str(args.motion), target_what=str(args.to))
+    print(f"map ({len(res.mapping)} joints, source -> target):")
+    for s, t in res.mapping.items():
+        print(f"  {s} -> {t}")
+    print(f"calibration: source {res.source_calibration.source}, target "
+          f"{res.target_calibration.source}; facing turn {res.facing_degrees:g} deg; "
+          f"scale {res.scale:.3f}; contact frames {res.contact.any(axis=1).sum()} of "
+          f"{len(res.times)}")
+    if args.save_map:
+        save_map(args.save_map, res.mapping)
+        print(f"wrote {Path(args.save_map).resolve()}")
+    out = Path(args.output)
+    new = res.clip
+    if out.suffix.lower() == ".json":
+        from ..io.clip_json import save_clip
+
+        save_clip(out, new)
+    else:
+        if new.name in target.clips:
+            print(f"rigedit: warning: replacing the target's clip {new.name!r}", file=sys.stderr)
+        target.clips[new.name] = new
+        target.save(out, clips=[new.name] if out.suffix.lower() == ".bvh" else None)
+    print(f"wrote {out.resolve()}: clip {new.name!r}, {new.duration:.2f} s, "
+          f"{len(res.times)} keys per track")
+    return 0
