@@ -95,7 +95,9 @@ def run_dqs(backend, rest, indices, weights, dq):
     kernels = skinning_kernels.load()
     out = np.empty((len(rest), 3), np.float32)
     f32 = lambda a: np.ascontiguousarray(a, dtype=np.float32)  # noqa: E731
-    kernels.dqs(f32(rest), np.ascontiguousarray(indices, dtype=np.int32), f32(weights), f32(dq),
+    pad = (0, 4 - np.shape(indices)[1])  # the kernel takes influences in groups of four
+    kernels.dqs(f32(rest), np.pad(np.asarray(indices, np.int32), ((0, 0), pad)),
+                np.pad(f32(weights), ((0, 0), pad)), f32(dq),
                 np.zeros((len(dq), 9), np.float32), False, out)
     return out
 

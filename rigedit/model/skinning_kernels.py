@@ -44,7 +44,7 @@ FASTMATH = {"contract", "reassoc", "nsz", "arcp"}
 # Replaced before compiling (numba reads module globals): numba.prange, and the vector blends
 # of skinning_simd (which imports numba, so it is imported only then).
 prange = range
-_blend_apply4 = _blend_apply4_normal = _check_groups = None
+_blend_apply4 = _blend_apply4_normal = _dq_blend4 = _check_groups = None
 
 
 def _check_groups_py(indices, palette):
@@ -130,12 +130,16 @@ def _dqs_py(rest, indices, weights, dq, scale, has_scale, out):
     dq (J, 8) f32: each joint's rigid part as a unit dual quaternion, real (x, y, z, w) then
     dual (x, y, z, w); scale (J, 9) f32: each joint's scale/shear part (row-major 3x3),
     blended linearly and applied to the rest point first when ``has_scale``. Each influence's
-    quaternion is flipped into the hemisphere of the vertex's strongest influence.
+    quaternion is flipped into the hemisphere of the vertex's strongest influence (the first:
+    influences sorted, padded to groups of four as for :func:`_lbs_py`); the blend of four is
+    one vector operation (:func:`.skinning_simd.dq_blend4`), the rest is scalar.
     """
+    if dq.shape[1] != 8 or indices.shape[1] % 4 != 0:
+        raise ValueError("expected dual quaternions of 8 floats and influences in groups of 4")
     n, k_max = indices.shape
     for v in prange(n):
         # the strongest influence (the first: sorted) fixes the hemisphere of the blend
-        pivot = dq[indices[v, 0]]
+        jp = indices[v, 0]
         x = rest[v, 0]
         y = rest[v, 1]
         z = rest[v, 2]
@@ -145,51 +149,45 @@ def _dqs_py(rest, indices, weights, dq, scale, has_scale, out):
                 w = weights[v, k]
                 if w == 0.0:
                     break
-                s = scale[indices[v, k]]
-                s0 += w * s[0]
-                s1 += w * s[1]
-                s2 += w * s[2]
-                s3 += w * s[3]
-                s4 += w * s[4]
-                s5 += w * s[5]
-                s6 += w * s[6]
-                s7 += w * s[7]
-                s8 += w * s[8]
+                j = indices[v, k]
+                s0 += w * scale[j, 0]
+                s1 += w * scale[j, 1]
+                s2 += w * scale[j, 2]
+                s3 += w * scale[j, 3]
+                s4 += w * scale[j, 4]
+                s5 += w * scale[j, 5]
+                s6 += w * scale[j, 6]
+                s7 += w * scale[j, 7]
+                s8 += w * scale[j, 8]
             x, y, z = (s0 * x + s1 * y + s2 * z, s3 * x + s4 * y + s5 * z,
                        s6 * x + s7 * y + s8 * z)
-        b0 = b1 = b2 = b3 = e0 = e1 = e2 = e3 = np.float32(0.0)
-        for k in range(k_max):
-            w = weights[v, k]
-            if w == 0.0:
+        b0, b1, b2, b3, e0, e1, e2, e3 = _dq_blend4(
+            dq, jp, indices[v, 0], indices[v, 1], indices[v, 2], indices[v, 3], weights[v, 0],
+            weights[v, 1], weights[v, 2], weights[v, 3])
+        for g in range(4, k_max, 4):
+            if weights[v, g] == 0.0:  # sorted: the rest are zero too
                 break
-            q = dq[indices[v, k]]
-            if q[0] * pivot[0] + q[1] * pivot[1] + q[2] * pivot[2] + q[3] * pivot[3] < np.float32(0.0):
-                w = -w
-            b0 += w * q[0]
-            b1 += w * q[1]
-            b2 += w * q[2]
-            b3 += w * q[3]
-            e0 += w * q[4]
-            e1 += w * q[5]
-            e2 += w * q[6]
-            e3 += w * q[7]
-        inv = np.float32(1.0) / np.sqrt(b0 * b0 + b1 * b1 + b2 * b2 + b3 * b3)
-        b0 *= inv
-        b1 *= inv
-        b2 *= inv
-        b3 *= inv
-        e0 *= inv
-        e1 *= inv
-        e2 *= inv
-        e3 *= inv
-        # p' = p + 2 r x (r x p + w p) + 2 (w d - e_w r + r x d), r = (b0, b1, b2), w = b3
+            c0, c1, c2, c3, d0, d1, d2, d3 = _dq_blend4(
+                dq, jp, indices[v, g], indices[v, g + 1], indices[v, g + 2], indices[v, g + 3],
+                weights[v, g], weights[v, g + 1], weights[v, g + 2], weights[v, g + 3])
+            b0 += c0
+            b1 += c1
+            b2 += c2
+            b3 += c3
+            e0 += d0
+            e1 += d1
+            e2 += d2
+            e3 += d3
+        # p' = p + 2 r x (r x p + w p) + 2 (w d - e_w r + r x d) for the normalised blend
+        # (r, w; d, e_w) = (b; e) / |b_real|; every term is quadratic in it, so the
+        # normalisation is one factor 2 / |b_real|^2 (no square root, no eight divisions).
+        two = np.float32(2.0) / (b0 * b0 + b1 * b1 + b2 * b2 + b3 * b3)
         cx = b1 * z - b2 * y + b3 * x
         cy = b2 * x - b0 * z + b3 * y
         cz = b0 * y - b1 * x + b3 * z
         tx = b3 * e0 - e3 * b0 + b1 * e2 - b2 * e1
         ty = b3 * e1 - e3 * b1 + b2 * e0 - b0 * e2
         tz = b3 * e2 - e3 * b2 + b0 * e1 - b1 * e0
-        two = np.float32(2.0)
         out[v, 0] = x + two * (b1 * cz - b2 * cy + tx)
         out[v, 1] = y + two * (b2 * cx - b0 * cz + ty)
         out[v, 2] = z + two * (b0 * cy - b1 * cx + tz)
@@ -272,13 +270,14 @@ class Kernels:
     """
 
     def __init__(self, numba):
-        global prange, _blend_apply4, _blend_apply4_normal, _check_groups
+        global prange, _blend_apply4, _blend_apply4_normal, _dq_blend4, _check_groups
         from . import skinning_simd
 
         prange = numba.prange
         _check_groups = numba.njit(_check_groups_py)
         _blend_apply4 = skinning_simd.blend_apply4
         _blend_apply4_normal = skinning_simd.blend_apply4_normal
+        _dq_blend4 = skinning_simd.dq_blend4
         self.max_threads = numba.config.NUMBA_NUM_THREADS
         self._call_lock = threading.Lock()
         f32 = numba.float32[:, ::1]

@@ -19,7 +19,7 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-__all__ = ["blend_apply4", "blend_apply4_normal", "ROW"]
+__all__ = ["blend_apply4", "blend_apply4_normal", "dq_blend4", "ROW"]
 
 ROW = 16  # floats per palette row
 _F32 = ir.FloatType()
@@ -97,6 +97,45 @@ def blend_apply4_normal(typingctx, palette, j0, j1, j2, j3, w0, w1, w2, w3, x, y
         p = _combine(builder, blended, args[9:12], base=_column(builder, blended, 3))
         n = _combine(builder, blended, args[12:15])
         out = [builder.extract_element(v, ir.Constant(_I32, i)) for v in (p, n) for i in range(3)]
+        return context.make_tuple(builder, signature.return_type, out)
+
+    return sig, codegen
+
+
+_DQ = ir.VectorType(_F32, 8)
+
+
+@intrinsic
+def dq_blend4(typingctx, dq, pivot, j0, j1, j2, j3, w0, w1, w2, w3):
+    """sum_k s_k w_k dq[j_k] for four influences, a dual quaternion as 8 floats (not
+    normalised), with s_k = -1 when dq[j_k]'s real part points away from dq[pivot]'s (the
+    antipodality flip), else 1. dq is (J, 8) float32: real (x, y, z, w), then dual."""
+    f32 = types.float32
+    sig = types.UniTuple(f32, 8)(dq, pivot, *([types.int32] * 4), *([f32] * 4))
+
+    def codegen(context, builder, signature, args):
+        table = context.make_array(signature.args[0])(context, builder, args[0])
+
+        def row(joint, vector_type):
+            if joint.type.width < 64:
+                joint = builder.sext(joint, _I64)
+            address = builder.gep(table.data, [builder.mul(joint, ir.Constant(_I64, 8))])
+            return builder.load(builder.bitcast(address, vector_type.as_pointer()), align=4)
+
+        pivot_real = row(args[1], _COL)
+        acc = None
+        for joint, weight in zip(args[2:6], args[6:10]):
+            q = row(joint, _DQ)
+            real = builder.shuffle_vector(q, q, ir.Constant(ir.VectorType(_I32, 4), [0, 1, 2, 3]))
+            prod = builder.fmul(real, pivot_real, flags=_FAST)
+            parts = [builder.extract_element(prod, ir.Constant(_I32, i)) for i in range(4)]
+            dot = builder.fadd(builder.fadd(parts[0], parts[1], flags=_FAST),
+                               builder.fadd(parts[2], parts[3], flags=_FAST), flags=_FAST)
+            away = builder.fcmp_ordered("<", dot, ir.Constant(_F32, 0.0))
+            signed = builder.select(away, builder.fneg(weight), weight)
+            term = builder.fmul(q, _splat(builder, signed, _DQ), flags=_FAST)
+            acc = term if acc is None else builder.fadd(acc, term, flags=_FAST)
+        out = [builder.extract_element(acc, ir.Constant(_I32, i)) for i in range(8)]
         return context.make_tuple(builder, signature.return_type, out)
 
     return sig, codegen
