@@ -213,8 +213,11 @@ class FileActions:
                                                  self.doc.skeleton.names),
             f"Saved weights to {path}")
 
-    def recompute_weights(self):
-        """Recompute the weights off the UI thread (progress, cancel); one undo step."""
+    def recompute_weights(self, method=None):
+        """Recompute the weights off the UI thread (progress, cancel); one undo step.
+        ``method`` is ``"heat"`` or ``"idw"``; by default heat for a mesh with faces."""
+        if not isinstance(method, str):  # a menu action's "checked" argument
+            method = None
         rig = self.doc.rig
         vertices, skeleton = rig.vertices, rig.skeleton
 
@@ -231,7 +234,7 @@ class FileActions:
             self.w.status(f"Recomputed weights for {len(vertices):,} vertices")
 
         return self.w.run_job("Computing weights",
-                              lambda report: weights_in_chunks(vertices, skeleton,
+                              lambda report: weights_in_chunks(vertices, skeleton, method,
                                                                report=report,
                                                                faces=rig.faces), done)
 

@@ -39,6 +39,7 @@ class JointPanel(QtWidgets.QWidget):
     slider_pressed(), slider_released()      bracket a slider drag (one undo step)
     translation_changed(int, object), scale_changed(int, object)
     reset_joint(int), reset_pose(), mirror(str)  "L" (left onto right) or "R"
+    deform_toggled(int, bool)                the joint's "deforms" flag (takes skin weight)
     """
 
     joint_clicked = QtCore.pyqtSignal(int)
@@ -51,6 +52,7 @@ class JointPanel(QtWidgets.QWidget):
     reset_joint = QtCore.pyqtSignal(int)
     reset_pose = QtCore.pyqtSignal()
     mirror = QtCore.pyqtSignal(str)
+    deform_toggled = QtCore.pyqtSignal(int, bool)
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -67,6 +69,12 @@ class JointPanel(QtWidgets.QWidget):
         self.title = QtWidgets.QLabel("No joint selected")
         self.title.setStyleSheet("font-weight: bold; padding: 2px 0;")
         layout.addWidget(self.title)
+        self.deform_box = QtWidgets.QCheckBox("Deforms (takes skin weight)")
+        self.deform_box.setToolTip("Off: the joint takes no weight when the weights are next "
+                                   "recomputed (a root carrier, a helper joint)")
+        self.deform_box.toggled.connect(
+            lambda on: self.joint is not None and self.deform_toggled.emit(self.joint, on))
+        layout.addWidget(self.deform_box)
 
         rot = QtWidgets.QGroupBox("Rotation (degrees from rest)")
         grid = QtWidgets.QGridLayout(rot)
@@ -141,7 +149,7 @@ class JointPanel(QtWidgets.QWidget):
 
     def _set_enabled(self, on):
         for w in (self.sliders + self.angle_boxes + self.translation_boxes + self.scale_boxes
-                  + [self.reset_joint_button]):
+                  + [self.reset_joint_button, self.deform_box]):
             w.setEnabled(on)
 
     # ------------------------------------------------------------------ from the document
@@ -171,7 +179,7 @@ class JointPanel(QtWidgets.QWidget):
         same_joint = joint is not None and joint == self.joint
         self.joint = joint
         widgets = (self.sliders + self.angle_boxes + self.translation_boxes + self.scale_boxes
-                   + [self.tree])
+                   + [self.tree, self.deform_box])
         for w in widgets:
             w.blockSignals(True)
         try:
@@ -187,6 +195,7 @@ class JointPanel(QtWidgets.QWidget):
                 item.setSelected(True)
                 self.tree.scrollToItem(item)
             self.title.setText(f"Joint: {pose.skeleton.names[joint]}")
+            self.deform_box.setChecked(bool(pose.skeleton.deform[joint]))
             angles = pose.get_euler(joint, degrees=True)
             if same_joint:
                 angles = nearest_euler(angles, self.angles())

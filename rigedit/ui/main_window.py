@@ -24,6 +24,7 @@ from .file_actions import FileActions
 from .joint_panel import InfoPanel, JointPanel
 from .jobs import JobsMixin
 from .weight_brush import install_weight_brush
+from .weight_tools import install_weight_tools
 
 __all__ = ["MainWindow", "default_rig"]
 
@@ -103,6 +104,7 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
         self.document.subscribe(self._on_document)
         self._load_scene()
         self.weight_brush = install_weight_brush(self)  # issue 10: rigedit/ui/weight_brush.py
+        install_weight_tools(self)  # DQS toggle, recompute method, deform flag
         self.autosave = Autosave(self)
         self.error_display = errors_hook.ErrorDisplay(self)
         errors_hook.install(self)
