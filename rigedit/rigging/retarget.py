@@ -182,6 +182,18 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
     n_frames, nj = len(times), len(tsk)
     rot = np.empty((n_frames, nj, 3, 3))
     rest_rot = Rotation.from_quat(tsk.rest_rotation).as_matrix()
+    src_feet = [src.slots[k] for k in ("foot_L", "foot_R")] + [
+        src.slots.get(k, src.slots[f]) for k, f in (("toe_L", "foot_L"), ("toe_R", "foot_R"))]
+    s_feet = smats[:, src_feet][..., :3, 3]
+    # the motion's own floor: a low percentile of the lowest foot point per frame
+    s_floor = float(np.percentile(s_feet[..., 1].min(axis=1), 5)) if n_frames > 1 else src.floor
+    rest_h = scal[src_feet, 1, 3] - src.joint_floor
+    contact = detect_contacts(s_feet - [0, s_floor, 0], rest_h, times, src.hip_height)
+    # feet and toes: pitch relative to each figure's flat foot, not the same direction (a
+    # BVH foot often points more steeply down than a mesh's: copied, the toes would dig in)
+    flat = {tgt.slots[f"{part}_{side}"]: contact[:, k] & contact[:, k + 2]
+            for k, side in enumerate("LR") for part in ("foot", "toe")
+            if f"{part}_{side}" in tgt.slots}
     pairs = []
     for j in range(nj):
         p = tsk.parents[j]
@@ -216,23 +228,19 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
         if vt is not None and j != tgt.slots["hips"]:
             u = t_rot_c[j].T @ vt
             want = _end_points(smats, s_spec) - smats[:, s, :3, 3]
+            if j in flat:
+                pitch = _pitch(want[flat[j]]) if flat[j].any() else _pitch(vs)
+                want = _pitched(want, float(np.median(pitch)) - _pitch(vt))
             r = swing(r @ u, want) @ r
             pairs.append((j, t_spec, s, s_spec))
         rot[:, j] = r
     scale = tgt.hip_height / src.hip_height
-    src_feet = [src.slots[k] for k in ("foot_L", "foot_R")] + [
-        src.slots.get(k, src.slots[f]) for k, f in (("toe_L", "foot_L"), ("toe_R", "foot_R"))]
-    s_feet = smats[:, src_feet][..., :3, 3]
-    # the motion's own floor: a low percentile of the lowest foot point per frame
-    s_floor = float(np.percentile(s_feet[..., 1].min(axis=1), 5)) if n_frames > 1 else src.floor
     hips_s = smats[:, inverse[tgt.slots["hips"]], :3, 3]
     hips_t = hips_s * scale
     hips_t[:, 1] = tgt.joint_floor + (hips_s[:, 1] - s_floor) * scale
     raw = _assemble(tsk, rot, tgt.slots["hips"], hips_t)
     tgt_feet = [tgt.slots[k] for k in ("foot_L", "foot_R")] + [
         tgt.slots.get(k, tgt.slots[f]) for k, f in (("toe_L", "foot_L"), ("toe_R", "foot_R"))]
-    rest_h = scal[src_feet, 1, 3] - src.joint_floor
-    contact = detect_contacts(s_feet - [0, s_floor, 0], rest_h, times, src.hip_height)
     mats = raw
     if clean_feet:
         rot = _clean_feet(tsk, tgt, rot, raw, contact, tgt_feet, times)
@@ -241,6 +249,19 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
                     tgt.slots["hips"])
     return RetargetResult(clip, dict(map), src, tgt, facing, scale, times, smats, raw, mats,
                           contact, s_floor, pairs)
+
+
+def _pitch(v):
+    """Angle (radians) of direction(s) ``v`` (..., 3) below the horizontal."""
+    v = unit(v)
+    return np.arcsin(np.clip(-v[..., 1], -1.0, 1.0))
+
+
+def _pitched(v, delta):
+    """Directions ``v`` (F, 3) turned up by ``delta`` radians about their horizontal normal."""
+    axis = unit(np.cross(v, [0.0, 1.0, 0.0]))
+    rv = Rotation.from_rotvec(axis * delta)
+    return rv.apply(v)
 
 
 def _assemble(skeleton, rot, hips, hips_pos):
