@@ -105,6 +105,24 @@ def test_open_cylinder_works_and_matches_the_closed_one_in_the_middle():
     assert np.all(np.diff(upper) >= -1e-9) and upper[0] < 0.05 and upper[-1] > 0.95
 
 
+def test_open_part_far_from_the_origin_is_oriented_by_its_own_centre():
+    # a cup: the cylinder without its top cap (the top centre is the last vertex); about
+    # the origin, 25 units below its rim, its signed volume would come out negative
+    v, f = cylinder(height=2.0, rings=21)
+    f = f[np.all(f < len(v) - 1, axis=1)]
+    v = v[:-1]
+    shift = np.array([40.0, 25.0, 30.0])
+    sk = chain_skeleton(2)
+    sk = Skeleton(sk.names, sk.parents, sk.rest_translation + [shift, [0] * 3],
+                  tails=sk.tails + shift)
+    res = heat(v + shift, sk, f)
+    assert len(res.fallback) == 0
+    normals = vertex_normals(v + shift, f)
+    side = np.abs(v[:, 1] - 1.0) < 0.9
+    radial = v * [1, 0, 1]
+    assert np.all(np.einsum("ij,ij->i", normals[side], radial[side]) > 0)   # outward
+
+
 def test_split_seam_duplicates_and_a_sliver_give_no_nan_and_agree_with_the_welded_mesh():
     v, f = cylinder(height=2.0, rings=21, segments=16)
     sk = chain_skeleton(2)

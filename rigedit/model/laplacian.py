@@ -162,8 +162,15 @@ def vertex_normals(vertices, faces, labels=None):
     tri = vertices[faces]
     fn = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     part = labels[faces[:, 0]]
-    volume = np.bincount(part, weights=np.einsum("ij,ij->i", fn, tri[:, 0]),
-                         minlength=labels.max() + 1 if len(labels) else 0)
+    parts = labels.max() + 1 if len(labels) else 0
+    # Signed volume about each part's own centre: for a closed part the centre does not
+    # matter, for an open one (a sleeve, a skirt) it keeps the sign from depending on where
+    # the part sits relative to the origin.
+    count = np.maximum(np.bincount(labels, minlength=parts), 1)
+    centre = np.stack([np.bincount(labels, vertices[:, k], parts) for k in range(3)], 1)
+    centre /= count[:, None]
+    volume = np.bincount(part, weights=np.einsum("ij,ij->i", fn, tri[:, 0] - centre[part]),
+                         minlength=parts)
     fn *= np.where(volume[part] < 0, -1.0, 1.0)[:, None]
     normals = np.zeros_like(vertices)
     for k in range(3):
