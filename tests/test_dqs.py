@@ -98,6 +98,7 @@ def run_dqs(backend, rest, indices, weights, dq):
     pad = (0, 4 - np.shape(indices)[1])  # the kernel takes influences in groups of four
     kernels.dqs(f32(rest), np.pad(np.asarray(indices, np.int32), ((0, 0), pad)),
                 np.pad(f32(weights), ((0, 0), pad)), f32(dq),
+                skinning_kernels.hemisphere_signs(f32(dq), np.empty((len(dq),) * 2, np.float32)),
                 np.zeros((len(dq), 9), np.float32), False, out)
     return out
 

@@ -164,6 +164,7 @@ class SkinBinding:
         self._palette16 = np.empty((self.num_joints, 16), dtype=np.float32)
         self._dq = np.empty((self.num_joints, 8), dtype=np.float32)
         self._scale = np.empty((self.num_joints, 9), dtype=np.float32)
+        self._signs = np.empty((self.num_joints, self.num_joints), dtype=np.float32)
         self._rest_normals32 = None  # set by bind_normals
         self._out_normals = None
         #: Threads of the compiled kernels: None picks one for small meshes, all for big ones
@@ -324,8 +325,9 @@ class SkinBinding:
                 dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
                 self._dq[:] = dq
                 self._scale[:] = scale.reshape(-1, 9)
+            skinning_kernels.hemisphere_signs(self._dq, self._signs)
             kernels.run("dqs", len(res), self.threads, self._rest32, self._indices32,
-                        self._weights32, self._dq, self._scale, has_scale, res)
+                        self._weights32, self._dq, self._signs, self._scale, has_scale, res)
             return res
         dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
         res[:] = dqs_skin(self.rest_vertices, self.indices, self.weights, dq,

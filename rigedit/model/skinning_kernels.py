@@ -124,18 +124,21 @@ def _lbs_normals_py(rest, rest_normals, indices, weights, palette, out, out_norm
         out_normals[v, 2] = c * inv
 
 
-def _dqs_py(rest, indices, weights, dq, scale, has_scale, out):
+def _dqs_py(rest, indices, weights, dq, signs, scale, has_scale, out):
     """Dual-quaternion skinning of every vertex (Kavan et al. 2008).
 
     dq (J, 8) f32: each joint's rigid part as a unit dual quaternion, real (x, y, z, w) then
-    dual (x, y, z, w); scale (J, 9) f32: each joint's scale/shear part (row-major 3x3),
+    dual (x, y, z, w); signs (J, J) f32: -1 where two joints' quaternions point into opposite
+    hemispheres, else 1 (:func:`hemisphere_signs`); scale (J, 9) f32: each joint's scale/shear part (row-major 3x3),
     blended linearly and applied to the rest point first when ``has_scale``. Each influence's
     quaternion is flipped into the hemisphere of the vertex's strongest influence (the first:
     influences sorted, padded to groups of four as for :func:`_lbs_py`); the blend of four is
     one vector operation (:func:`.skinning_simd.dq_blend4`), the rest is scalar.
     """
-    if dq.shape[1] != 8 or indices.shape[1] % 4 != 0:
-        raise ValueError("expected dual quaternions of 8 floats and influences in groups of 4")
+    if (dq.shape[1] != 8 or indices.shape[1] % 4 != 0 or signs.shape[0] != dq.shape[0]
+            or signs.shape[1] != dq.shape[0]):
+        raise ValueError("expected dual quaternions of 8 floats, a (J, J) sign table and "
+                         "influences in groups of 4")
     n, k_max = indices.shape
     for v in prange(n):
         # the strongest influence (the first: sorted) fixes the hemisphere of the blend
@@ -162,13 +165,13 @@ def _dqs_py(rest, indices, weights, dq, scale, has_scale, out):
             x, y, z = (s0 * x + s1 * y + s2 * z, s3 * x + s4 * y + s5 * z,
                        s6 * x + s7 * y + s8 * z)
         b0, b1, b2, b3, e0, e1, e2, e3 = _dq_blend4(
-            dq, jp, indices[v, 0], indices[v, 1], indices[v, 2], indices[v, 3], weights[v, 0],
+            dq, signs, jp, indices[v, 0], indices[v, 1], indices[v, 2], indices[v, 3], weights[v, 0],
             weights[v, 1], weights[v, 2], weights[v, 3])
         for g in range(4, k_max, 4):
             if weights[v, g] == 0.0:  # sorted: the rest are zero too
                 break
             c0, c1, c2, c3, d0, d1, d2, d3 = _dq_blend4(
-                dq, jp, indices[v, g], indices[v, g + 1], indices[v, g + 2], indices[v, g + 3],
+                dq, signs, jp, indices[v, g], indices[v, g + 1], indices[v, g + 2], indices[v, g + 3],
                 weights[v, g], weights[v, g + 1], weights[v, g + 2], weights[v, g + 3])
             b0 += c0
             b1 += c1
@@ -261,6 +264,17 @@ def _rigid_dual_quaternions_py(palette, tol, dq):
     return True
 
 
+def hemisphere_signs(dq, out):
+    """out[a, b] = -1 where joints a and b's rotation quaternions (dq[:, :4]) point into
+    opposite hemispheres, else 1: the DQS kernel's antipodality flips, once per frame.
+
+    dq : (J, 8) float32; out : (J, J) float32
+    """
+    np.matmul(dq[:, :4], dq[:, :4].T, out=out)
+    np.copysign(np.float32(1.0), out, out=out)
+    return out
+
+
 class Kernels:
     """The compiled kernels (attributes ``lbs``, ``lbs_normals``, ``dqs``,
     ``rigid_dual_quaternions``) and numba itself.
@@ -287,7 +301,7 @@ class Kernels:
         self.lbs = numba.njit([numba.void(f32, i32, f32, f32, f32)], **opts)(_lbs_py)
         self.lbs_normals = numba.njit([numba.void(f32, f32, i32, f32, f32, f32, f32)],
                                       **opts)(_lbs_normals_py)
-        self.dqs = numba.njit([numba.void(f32, i32, f32, f32, f32, numba.boolean, f32)],
+        self.dqs = numba.njit([numba.void(f32, i32, f32, f32, f32, f32, numba.boolean, f32)],
                               **opts)(_dqs_py)
         self.rigid_dual_quaternions = numba.njit(
             [numba.boolean(numba.float64[:, :, ::1], numba.float64, f32)],
