@@ -133,7 +133,9 @@ def _dqs_py(rest, indices, weights, dq, signs, scale, has_scale, out):
     blended linearly and applied to the rest point first when ``has_scale``. Each influence's
     quaternion is flipped into the hemisphere of the vertex's strongest influence (the first:
     influences sorted, padded to groups of four as for :func:`_lbs_py`); the blend of four is
-    one vector operation (:func:`.skinning_simd.dq_blend4`), the rest is scalar.
+    one vector operation (:func:`.skinning_simd.dq_blend4`), the rest is scalar; the
+    normalisation is one factor 2/|b|^2, as every term of the transform is quadratic in the
+    blend.
     """
     if (dq.shape[1] != 8 or indices.shape[1] % 4 != 0 or signs.shape[0] != dq.shape[0]
             or signs.shape[1] != dq.shape[0]):

@@ -5,8 +5,9 @@ llvmlite). numba 0.68 compiles the per-vertex blend of a 3x4 palette as scalar m
 whatever the source's layout, which made LBS compute-bound at about 10 ns per vertex with four
 influences (the FMA units' scalar rate); written here directly as LLVM vector operations on
 16-float rows, a vertex's four influences are four 16-wide multiply-adds and the frame runs at
-about 2 ns per vertex, close to the memory-copy floor (measured: 2.1 ms of CPU for 1M vertices
-against 1.5 ms for the floor). LLVM lowers the 16-wide vectors to whatever the CPU has (AVX-512,
+about 3 ns per vertex, about twice the memory-copy floor (measured by
+``benchmarks/bench_skinning.py``: 3.1-3.7 ms of CPU for 1M vertices against 1.5 ms for copying
+their 56 bytes each). LLVM lowers the 16-wide vectors to whatever the CPU has (AVX-512,
 two AVX halves, four SSE quarters).
 
 The palette row of joint ``j`` is its skinning matrix ``K_j`` transposed and flattened:
