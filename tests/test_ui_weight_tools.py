@@ -66,7 +66,8 @@ def test_recompute_weights_with_a_chosen_method(demo_window, qtbot):
     assert not np.allclose(a, b)  # the two entries do differ
 
 
-def test_deform_flag_toggle_is_undoable_and_the_joint_takes_no_weight(demo_window, qtbot):
+def test_deform_flag_toggle_is_undoable_and_the_joint_takes_no_weight(demo_window, qtbot,
+                                                                     tmp_path):
     w = demo_window
     d = w.document
     rig = d.rig
@@ -89,3 +90,7 @@ def test_deform_flag_toggle_is_undoable_and_the_joint_takes_no_weight(demo_windo
     assert rig.skeleton.deform[j] and box.isChecked()
     d.redo()
     assert not rig.skeleton.deform[j] and not box.isChecked()
+    import rigedit  # the flag is saved with the skeleton
+
+    assert w.files.save_to(tmp_path / "rig")
+    assert not rigedit.load_rig(tmp_path / "rig").skeleton.deform[j]
