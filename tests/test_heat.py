@@ -80,6 +80,17 @@ def test_numpy_ray_tests_give_the_same_weights_as_the_compiled_ones():
     np.testing.assert_allclose(dense_weights(*a, 3), dense_weights(*b, 3), atol=1e-9)
 
 
+def test_superlu_and_cholmod_give_the_same_weights():
+    from rigedit.model import heat as heat_module
+    if heat_module._cholmod is None:
+        pytest.skip("scikit-sparse not installed: SuperLU is the only solver")
+    v, f = cylinder(height=3.0)
+    sk = chain_skeleton(3)
+    a = heat(v, sk, f, solver="cholmod")
+    b = heat(v, sk, f, solver="splu")
+    np.testing.assert_allclose(dense_weights(*a, 3), dense_weights(*b, 3), atol=1e-9)
+
+
 # ---------------------------------------------------------------------------- any mesh
 def test_two_parts_every_vertex_weighted_and_the_far_part_reported():
     v, f = cylinder(height=3.0)
