@@ -94,3 +94,17 @@ def test_deform_flag_toggle_is_undoable_and_the_joint_takes_no_weight(demo_windo
 
     assert w.files.save_to(tmp_path / "rig")
     assert not rigedit.load_rig(tmp_path / "rig").skeleton.deform[j]
+
+
+def test_video_export_skins_as_the_view_does(demo_window, qtbot, monkeypatch, tmp_path):
+    from rigedit.ui import record_dialog
+
+    seen = []
+    monkeypatch.setattr(record_dialog, "record_clip",
+                        lambda *a, **kw: seen.append(kw["skinning"]) or 1)
+    w = demo_window
+    w.record_video(tmp_path / "a.mp4", duration=0.1, progress=False)
+    w.dqs_action.trigger()
+    w.record_video(tmp_path / "b.mp4", duration=0.1, progress=False)
+    w.record_video(tmp_path / "c.mp4", duration=0.1, progress=False, skinning="lbs")
+    assert seen == ["lbs", "dqs", "lbs"]

@@ -72,6 +72,7 @@ def record_video(window, path, fps=30, duration=None, size=(1280, 720), start=0.
             dialog.setValue(done)
             QtWidgets.QApplication.processEvents()
             return not dialog.wasCanceled()
+    options.setdefault("skinning", window.scene.skinning)  # as the view shows it (LBS/DQS)
     try:
         n = record_clip(doc.rig, clip_obj, path, fps=fps, duration=duration, size=size,
                         start=start, camera=cam, orbit=turn, follow_root=follow_root,
