@@ -93,7 +93,10 @@ class Calibration:
     joint_floor : float
         Lowest foot or toe joint in the pose (tails left out, as not every format has them).
     hip_height : float
-        The hip height of the figure standing straight: thigh, shin and ankle height.
+        The height of the thigh joints of the figure standing straight: thigh, shin and
+        ankle height (the leg length).
+    hip_offset : float
+        Height of the hips joint above the thigh joints in the pose.
     """
 
     def __init__(self, skeleton, mats, source, what):
@@ -107,13 +110,15 @@ class Calibration:
         self.feet = [s[k] for k in ("foot_L", "foot_R", "toe_L", "toe_R") if k in s]
         self.floor = float(self.foot_points(mats[None])[0, :, 1].min())
         self.joint_floor = float(p[self.feet, 1].min())
-        # Standing hip height: hips above the thigh joints, plus thigh, shin and the lower
-        # ankle's height, so a rest with splayed or bent legs (CMU's) does not shrink it.
-        legs = [p[s["hips"], 1] - p[s[f"thigh_{k}"], 1]
-                + np.linalg.norm(p[s[f"shin_{k}"]] - p[s[f"thigh_{k}"]])
+        # Leg length standing: thigh, shin and the lower ankle's height, so a rest with
+        # splayed or bent legs (CMU's) does not shrink it; the hips joint sits hip_offset
+        # above the thigh joints (a deep pelvis is not leg).
+        legs = [np.linalg.norm(p[s[f"shin_{k}"]] - p[s[f"thigh_{k}"]])
                 + np.linalg.norm(p[s[f"foot_{k}"]] - p[s[f"shin_{k}"]]) for k in "LR"]
         ankle = min(p[s["foot_L"], 1], p[s["foot_R"], 1]) - self.joint_floor
         self.hip_height = float(np.mean(legs) + ankle)
+        self.hip_offset = float(p[s["hips"], 1] - np.mean([p[s["thigh_L"], 1],
+                                                           p[s["thigh_R"], 1]]))
 
     def foot_points(self, mats):
         """(F, P, 3) model positions of the foot and toe joints (and their tails)."""

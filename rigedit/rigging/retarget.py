@@ -13,8 +13,10 @@ between two mapped ones bend). When both rests stand alike, ``X`` is the identit
 ``S(t) · S_c⁻¹ · T_c``. The source is first turned about the vertical axis by the multiple of
 90 degrees that brings its facing (heel to toe) onto the target's.
 
-The hips follow the source's hips scaled by the ratio of hip heights (target / source), both
-horizontally and vertically, above the target's floor. Then the feet are cleaned up
+The hips follow the source's hips scaled by the ratio of hip heights (target / source, each
+the height of the thigh joints standing straight: the leg length), both horizontally and
+vertically, above the target's floor (its lowest foot joint at rest); vertically it is the
+thigh joints that are placed, so a deeper pelvis does not shorten the legs' reach. Then the feet are cleaned up
 (:mod:`.contacts`).
 """
 from __future__ import annotations
@@ -237,13 +239,15 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
     scale = tgt.hip_height / src.hip_height
     hips_s = smats[:, inverse[tgt.slots["hips"]], :3, 3]
     hips_t = hips_s * scale
-    hips_t[:, 1] = tgt.joint_floor + (hips_s[:, 1] - s_floor) * scale
+    # the thigh joints go where the source's go, scaled: the pelvis depth is each one's own
+    hips_t[:, 1] = tgt.joint_floor + (hips_s[:, 1] - s_floor - src.hip_offset) * scale \
+        + tgt.hip_offset
     raw = _assemble(tsk, rot, tgt.slots["hips"], hips_t)
     tgt_feet = [tgt.slots[k] for k in ("foot_L", "foot_R")] + [
         tgt.slots.get(k, tgt.slots[f]) for k, f in (("toe_L", "foot_L"), ("toe_R", "foot_R"))]
     mats = raw
     if clean_feet:
-        rot = _clean_feet(tsk, tgt, rot, raw, contact, tgt_feet, times)
+        rot = _clean_feet(tsk, tgt, rot, raw, contact, tgt_feet, times, inverse)
         mats = _assemble(tsk, rot, tgt.slots["hips"], hips_t)
     clip = _to_clip(tsk, mats, rot, times, name or source_clip.name, source_clip,
                     tgt.slots["hips"])
@@ -286,8 +290,10 @@ def _assemble(skeleton, rot, hips, hips_pos):
     return mats
 
 
-def _clean_feet(skeleton, tgt, rot, mats, contact, feet, times):
-    """Leg IK holding each contact (ankle or toe) where it was on average, feet above floor."""
+def _clean_feet(skeleton, tgt, rot, mats, contact, feet, times, mapped):
+    """Hold each contact where it was on average (the ankle moves the foot, the foot turns
+    about the ankle to put the toe on its pin while both touch), keep every foot point above
+    its rest height, and solve the legs for the new ankles (two-bone IK)."""
     rot = rot.copy()
     pts = mats[:, feet][..., :3, 3]
     rest_pts = tgt.mats[feet, :3, 3]
@@ -295,30 +301,47 @@ def _clean_feet(skeleton, tgt, rot, mats, contact, feet, times):
     offsets, weights = pin_offsets(pts, contact, rest_pts[:, 1], max(2, int(round(0.1 / dt))))
     hips_rot = rot[:, tgt.slots["hips"]]
     for side, (ankle_i, toe_i) in (("L", (0, 2)), ("R", (1, 3))):
-        w = weights[:, [ankle_i, toe_i]]
-        # the ball of the foot is the pivot when both touch (the heel lifts about it)
-        delta = w[:, 1:] * offsets[:, toe_i] + (1 - w[:, 1:]) * w[:, :1] * offsets[:, ankle_i]
-        goal = pts[:, ankle_i] + delta
+        wa, wt = weights[:, ankle_i, None], weights[:, toe_i, None]
+        da, dtoe = offsets[:, ankle_i], offsets[:, toe_i]
+        delta = wa * da + (1 - wa) * wt * dtoe
+        ankle, toe = pts[:, ankle_i], pts[:, toe_i]
+        goal = ankle + delta
+        foot_j, toe_j = feet[ankle_i], feet[toe_i]
+        turn = np.broadcast_to(np.eye(3), (len(times), 3, 3))
+        if toe_j != foot_j:
+            want_toe = toe + delta + wt * (dtoe - delta)
+            turn = swing(toe - ankle, want_toe - goal)
+            for k in skeleton.subtree(foot_j):
+                rot[:, k] = turn @ rot[:, k]
         # no foot point (ankle, toe, toe tip) below its rest height
-        low = np.c_[pts[:, [ankle_i, toe_i], 1], _tail_y(skeleton, mats, feet[toe_i])]
-        rest_low = np.r_[rest_pts[[ankle_i, toe_i], 1], _tail_y(skeleton, tgt.mats[None],
-                                                               feet[toe_i])[0]]
-        lift = np.nanmax(np.maximum(0.0, rest_low[None] - (low + delta[:, 1:2])), axis=1)
+        low = [goal[:, 1], (goal + np.einsum("fab,fb->fa", turn, toe - ankle))[:, 1]]
+        rest_low = [rest_pts[ankle_i, 1], rest_pts[toe_i, 1]]
+        tip = _tail_point(skeleton, mats, toe_j)
+        if tip is not None:
+            low.append((goal + np.einsum("fab,fb->fa", turn, tip - ankle))[:, 1])
+            rest_low.append(_tail_point(skeleton, tgt.mats[None], toe_j)[0, 1])
+        lift = np.max(np.maximum(0.0, np.array(rest_low)[None] - np.stack(low, axis=1)), axis=1)
         goal[:, 1] += lift
         th, sh = tgt.slots[f"thigh_{side}"], tgt.slots[f"shin_{side}"]
         normal = hips_rot @ (rotations_of(tgt.mats)[tgt.slots["hips"]].T @ tgt.left)
         rot[:, th], rot[:, sh] = two_bone_ik(
-            mats[:, th, :3, 3], mats[:, sh, :3, 3], pts[:, ankle_i], goal,
-            rot[:, th], rot[:, sh], normal)
+            mats[:, th, :3, 3], mats[:, sh, :3, 3], ankle, goal, rot[:, th], rot[:, sh],
+            normal)
+    # joints the map leaves out keep their rest pose below the turned ones
+    rest_rot = Rotation.from_quat(skeleton.rest_rotation).as_matrix()
+    for j in range(len(skeleton)):
+        p = skeleton.parents[j]
+        if j not in mapped and p >= 0:
+            rot[:, j] = rot[:, p] @ rest_rot[j]
     return rot
 
 
-def _tail_y(skeleton, mats, j):
-    """(F, 1) model height of joint ``j``'s tail (NaN when it has none)."""
+def _tail_point(skeleton, mats, j):
+    """(F, 3) model position of joint ``j``'s tail, or None when it has none."""
     if not np.all(np.isfinite(skeleton.tails[j])):
-        return np.full((len(mats), 1), np.nan)
+        return None
     local = skeleton.inverse_bind_matrices[j] @ np.r_[skeleton.tails[j], 1.0]
-    return (mats[:, j] @ local)[:, 1:2]
+    return (mats[:, j] @ local)[:, :3]
 
 
 def _to_clip(skeleton, mats, rot, times, name, source_clip, hips):
