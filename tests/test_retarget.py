@@ -303,3 +303,17 @@ def test_find_slots_needs_legs(humanoid):
     legless = Skeleton(names, parents, sk.rest_translation[keep])
     with pytest.raises(ValueError, match="two legs"):
         find_slots(legless, pts[keep], "legless.json")
+
+
+def test_spine_bend_shared_with_unmapped_joint(humanoid):
+    """Bandai's spine has one joint between hips and chest, the humanoid's two: the unmapped
+    one takes part of the bend (it is not left at rest), and the mapped bones still point
+    like the source's."""
+    res = retarget_result(_load(WALK), "take", humanoid)
+    assert "Spine" not in res.mapping.values() and "Spine1" in res.mapping.values()
+    j = humanoid.skeleton.index["Spine"]
+    track = res.clip.tracks[("Spine", "rotation")]
+    rest = Rotation.from_quat(humanoid.skeleton.rest_rotation[j])
+    angles = (rest.inv() * Rotation.from_quat(track.values)).magnitude()
+    assert np.degrees(angles.max()) > 1.0
+    assert direction_errors(res)["spine"] < 0.1

@@ -236,6 +236,7 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
             r = swing(r @ u, want) @ r
             pairs.append((j, t_spec, s, s_spec))
         rot[:, j] = r
+    _distribute(tsk, tgt, rot, inverse)
     scale = tgt.hip_height / src.hip_height
     hips_s = smats[:, inverse[tgt.slots["hips"]], :3, 3]
     hips_t = hips_s * scale
@@ -253,6 +254,44 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
                     tgt.slots["hips"])
     return RetargetResult(clip, dict(map), src, tgt, facing, scale, times, smats, raw, mats,
                           contact, s_floor, pairs)
+
+
+def _distribute(skeleton, tgt, rot, mapped):
+    """Share the bend between two mapped spine or neck joints with the unmapped joints
+    between them (a source spine of 2 joints onto a target of 3), in place.
+
+    With ``a`` and ``b`` consecutive mapped joints of the chain and ``k`` unmapped joints
+    between, ``D`` is ``b``'s turn beyond its calibration relation to ``a``; the ``i``-th joint
+    between takes ``D^(i/(k+1))`` (so the bend is spread and ``b`` keeps its orientation).
+    Unless ``a`` is the hips (whose orientation is the whole body's), one swing at ``a`` then
+    re-aims ``a -> b`` where it pointed.
+    """
+    cal = rotations_of(tgt.mats)
+    for chain in (tgt.chains["spine"], [tgt.slots["chest"]] + tgt.chains["neck"]):
+        marks = [i for i, j in enumerate(chain) if j in mapped]
+        for i0, i1 in zip(marks[:-1], marks[1:]):
+            a, b, run = chain[i0], chain[i1], chain[i0 + 1:i1]
+            if not run:
+                continue
+            rigid = rot[:, a] @ (cal[a].T @ cal[b])
+            delta = Rotation.from_matrix(rot[:, b] @ np.swapaxes(rigid, -1, -2)).as_rotvec()
+            before = _chain_vector(skeleton, rot, run + [b])
+            n = len(run) + 1
+            for k, j in enumerate(run, 1):
+                step = Rotation.from_rotvec(delta * (k / n)).as_matrix()
+                rot[:, j] = step @ rot[:, a] @ (cal[a].T @ cal[j])
+            if a != tgt.slots["hips"]:
+                turn = swing(_chain_vector(skeleton, rot, run + [b]), before)
+                for j in [a] + run:
+                    rot[:, j] = turn @ rot[:, j]
+
+
+def _chain_vector(skeleton, rot, joints):
+    """(F, 3) model vector from the parent of ``joints[0]`` to ``joints[-1]`` through each
+    joint's rest offset, each turned by its parent's model rotation."""
+    return sum(rot[:, skeleton.parents[j]] @ (skeleton.rest_translation[j]
+                                             * skeleton.rest_scale[skeleton.parents[j]])
+               for j in joints)
 
 
 def _pitch(v):
@@ -327,12 +366,12 @@ def _clean_feet(skeleton, tgt, rot, mats, contact, feet, times, mapped):
         rot[:, th], rot[:, sh] = two_bone_ik(
             mats[:, th, :3, 3], mats[:, sh, :3, 3], ankle, goal, rot[:, th], rot[:, sh],
             normal)
-    # joints the map leaves out keep their rest pose below the turned ones
+    # joints the map leaves out in the legs keep their rest pose below the turned ones
     rest_rot = Rotation.from_quat(skeleton.rest_rotation).as_matrix()
-    for j in range(len(skeleton)):
-        p = skeleton.parents[j]
-        if j not in mapped and p >= 0:
-            rot[:, j] = rot[:, p] @ rest_rot[j]
+    for side in "LR":
+        for j in skeleton.subtree(tgt.slots[f"thigh_{side}"])[1:]:
+            if j not in mapped:
+                rot[:, j] = rot[:, skeleton.parents[j]] @ rest_rot[j]
     return rot
 
 
