@@ -113,8 +113,28 @@ def _third_party(path, read):
         raise RigFileError(path, f"cannot read mesh: {detail[:200]}") from None
 
 
+def _check_ply_header(path, size):
+    """meshio's PLY reader loops for ever on a header without ``end_header`` and trusts the
+    element counts: check both before it runs."""
+    with open(path, "rb") as fh:
+        head = fh.read(65536)
+    end = head.find(b"end_header")
+    if not head.startswith(b"ply") or end < 0:
+        raise RigFileError(path, "expected a PLY header ('ply' ... 'end_header') in the first "
+                                 "64 KiB, got none")
+    for line in head[:end].decode("ascii", "replace").splitlines():
+        parts = line.split()
+        if len(parts) == 3 and parts[0] == "element":
+            if not parts[2].isdigit() or int(parts[2]) > size:
+                raise RigFileError(path, f"expected an element count the file can hold, got "
+                                         f"{line.strip()[:60]!r} in a file of {size} bytes")
+
+
 def _read_meshio(path):
     import meshio  # imported here: only these formats need it
+
+    if path.suffix.lower() == ".ply":
+        _check_ply_header(path, path.stat().st_size)
 
     m = _third_party(path, lambda: meshio.read(path))
     polys = []
@@ -130,40 +150,6 @@ def _read_meshio(path):
     if any(i < 0 or i > MAX_INDEX for p in polys for i in (min(p, default=0), max(p, default=0))):
         raise RigFileError(path, f"expected face indices from 0 to {MAX_INDEX}")
     return points[:, :3].astype(np.float64), triangulate(polys)
-
-
-def _read_vtp(path):
-    # VTP (XML PolyData) is not among meshio's formats; VTK reads it. This is the one place
-    # below rigedit/render that touches VTK, and only when a VTP file is opened. VTK prints a
-    # bad file's errors to the terminal from C++ (its logger and output window, observers
-    # see only some of them): display is off for the read, and an empty result is the error.
-    from vtkmodules.util.numpy_support import vtk_to_numpy
-    from vtkmodules.vtkCommonCore import vtkObject
-    from vtkmodules.vtkFiltersCore import vtkTriangleFilter
-    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
-
-    def read():
-        reader = vtkXMLPolyDataReader()
-        reader.SetFileName(str(path))
-        tri = vtkTriangleFilter()
-        tri.SetInputConnection(reader.GetOutputPort())
-        tri.PassVertsOff()
-        tri.PassLinesOff()
-        tri.Update()
-        return reader.GetErrorCode(), tri.GetOutput()
-
-    shown = vtkObject.GetGlobalWarningDisplay()
-    vtkObject.GlobalWarningDisplayOff()
-    try:
-        code, poly = _third_party(path, read)
-    finally:
-        vtkObject.SetGlobalWarningDisplay(shown)
-    if poly is None or poly.GetNumberOfPoints() == 0 or poly.GetPolys() is None:
-        raise RigFileError(path, "cannot read mesh: expected VTK XML PolyData with points, "
-                                 f"got none (VTK error code {code})")
-    points = vtk_to_numpy(poly.GetPoints().GetData()).astype(np.float64)
-    conn = vtk_to_numpy(poly.GetPolys().GetConnectivityArray()).astype(np.int64)
-    return points, conn.reshape(-1, 3) if len(conn) % 3 == 0 else triangulate([])
 
 
 def load_mesh(path, weld=True):
@@ -191,7 +177,9 @@ def load_mesh(path, weld=True):
     if suffix == ".obj":
         vertices, faces = _read_obj(path)
     elif suffix == ".vtp":
-        vertices, faces = _read_vtp(path)
+        from .vtp import read_vtp
+
+        vertices, faces = read_vtp(path)
     elif suffix in MESH_SUFFIXES:
         vertices, faces = _read_meshio(path)
     else:

@@ -82,9 +82,12 @@ def read_bytes(path, max_bytes=MAX_FILE_BYTES):
         # O_NONBLOCK: should the path have become a FIFO since the check, open returns at once.
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
         with os.fdopen(fd, "rb") as fh:
-            if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+            st = os.fstat(fh.fileno())
+            if not stat.S_ISREG(st.st_mode):
                 raise RigFileError(path, "expected a regular file")
-            data = fh.read(max_bytes + 1)
+            # read(n) allocates n bytes up front: ask for the size the file has (one more
+            # byte tells a file that grew past the bound).
+            data = fh.read(min(st.st_size, max_bytes) + 1)
     except OSError as exc:
         raise RigFileError(path, os_problem(exc)) from None
     if len(data) > max_bytes:

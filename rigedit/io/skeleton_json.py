@@ -26,8 +26,8 @@ import numpy as np
 from ..errors import RigFileError
 from ..model.skeleton import Skeleton, topological_order
 from .atomic import write_json
-from .jsonfile import (MAX_MAGNITUDE, boolean, choice, name, optional, read_json, require,
-                       vector)
+from .jsonfile import (MAX_MAGNITUDE, boolean, choice, name, numbers, optional, read_json,
+                       require, vector)
 
 __all__ = ["load_skeleton", "save_skeleton", "skeleton_from_heads", "skeleton_to_dict",
            "UP_AXES"]
@@ -118,12 +118,8 @@ def _bind_matrix(path, joint, value):
     """(4, 4) float64 bind matrix of a joint (row-major nested lists), or None if absent."""
     if value is None:
         return None
-    try:
-        m = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        m = None
-    if m is None or m.shape != (4, 4) or not np.all(np.isfinite(m)) \
-            or not np.allclose(m[3], [0, 0, 0, 1]) or abs(np.linalg.det(m[:3, :3])) < 1e-12:
+    m = numbers(path, value, "'bind_matrix'", width=4, count=4, where=f"joint {joint!r}")
+    if not np.allclose(m[3], [0, 0, 0, 1]) or abs(np.linalg.det(m[:3, :3])) < 1e-12:
         raise RigFileError(path, f"joint {joint!r}: expected 'bind_matrix' to be an invertible "
                                  f"affine 4x4 matrix (rows, last [0, 0, 0, 1]), got "
                                  f"{str(value)[:80]}")
