@@ -22,10 +22,10 @@ def gate(monkeypatch):
     event = threading.Event()
     real = drag.weights_in_chunks
 
-    def slow(vertices, skeleton, report=None, **kw):
+    def slow(vertices, skeleton, *args, report=None, **kw):
         while not event.wait(0.01):
             report(0.0)  # raises Cancelled once the user cancelled
-        return real(vertices, skeleton, report=report, **kw)
+        return real(vertices, skeleton, *args, report=report, **kw)
 
     monkeypatch.setattr(drag, "weights_in_chunks", slow)
     monkeypatch.setattr(file_actions, "weights_in_chunks", slow)
