@@ -120,6 +120,7 @@ def check_options(args):
 
 
 def cmd_render(args):
+    from .cli_output import check_interrupted
     from .render.recorder import record_clip
 
     size = _parse_size(args.size)
@@ -139,6 +140,7 @@ def cmd_render(args):
         bar = tqdm(total=None, unit="frame", desc=f"render {args.clip}")
 
     def progress(done, total):
+        check_interrupted()
         if bar is not None:
             bar.total = total
             bar.update(done - bar.n)

@@ -6,6 +6,9 @@ written when the run is interrupted.
 - :func:`interruptible` turns SIGINT (Ctrl-C) and SIGTERM into an :class:`Interrupted`
   exception, so the writers' clean-up (``finally`` blocks that delete their temporary file)
   runs; the command then prints one line and exits with 128 + the signal number (130, 143).
+  Long jobs call :func:`check_interrupted` between steps: an exception raised while Python
+  code ran inside a VTK callback is swallowed there, and would otherwise leave the job
+  running.
 """
 from __future__ import annotations
 
@@ -17,7 +20,10 @@ from pathlib import Path
 from .errors import RigFileError
 from .io.atomic import check_output_folder
 
-__all__ = ["Interrupted", "interruptible", "check_output"]
+__all__ = ["Interrupted", "interruptible", "check_interrupted", "check_output"]
+
+#: Signals received within :func:`interruptible`, oldest first.
+_received = []
 
 
 class Interrupted(BaseException):
@@ -34,11 +40,18 @@ class Interrupted(BaseException):
 
 
 def _raise_interrupted(signum, frame):
-    # Further signals are ignored while the clean-up runs, so a second Ctrl-C cannot leave
-    # the temporary file behind.
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, signal.SIG_IGN)
-    raise Interrupted(signum)
+    # Only the first signal raises: a second Ctrl-C must not break into the clean-up that the
+    # first one started (and leave the temporary file behind).
+    _received.append(signum)
+    if len(_received) == 1:
+        raise Interrupted(signum)
+
+
+def check_interrupted():
+    """Raise :class:`Interrupted` again when a signal came (its first exception may have been
+    swallowed by a VTK callback)."""
+    if _received:
+        raise Interrupted(_received[0])
 
 
 @contextlib.contextmanager
@@ -48,6 +61,7 @@ def interruptible():
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    _received.clear()
     previous = {sig: signal.signal(sig, _raise_interrupted)
                 for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
@@ -55,6 +69,7 @@ def interruptible():
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
+        _received.clear()
 
 
 def check_output(path, folder_ok=False):

@@ -178,3 +178,23 @@ def test_a_folder_that_refuses_the_temporary_file_is_reported_as_the_target(tmp_
         write_json(tmp_path / "x.json", {})
     assert info.value.filename == str(tmp_path / "x.json")
     assert "Permission denied" in str(info.value) and ".x.json." not in str(info.value)
+
+
+def test_a_swallowed_interrupt_is_raised_again_and_a_second_one_waits():
+    """A VTK callback swallows the exception a signal raised inside it: the job's next
+    check raises it again; a second signal does not break into the clean-up."""
+    from rigedit.cli_output import Interrupted, check_interrupted, interruptible
+
+    with pytest.raises(Interrupted) as info:
+        with interruptible():
+            check_interrupted()                       # nothing received yet
+            try:
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(1)                          # the handler runs here
+            except BaseException:                      # as a VTK callback would
+                pass
+            os.kill(os.getpid(), signal.SIGINT)        # during clean-up: only recorded
+            time.sleep(0.05)
+            check_interrupted()
+    assert info.value.exit_status == 143
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL   # handlers restored
