@@ -14,9 +14,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .calibrate import swing, unit
+from scipy.spatial.transform import Rotation
 
-__all__ = ["detect_contacts", "runs", "pin_offsets", "two_bone_ik", "HEIGHT_TOL", "SPEED_TOL"]
+from .calibrate import rotations_of, swing, unit
+
+__all__ = ["detect_contacts", "runs", "pin_offsets", "two_bone_ik", "clean_feet", "tail_point",
+           "HEIGHT_TOL", "SPEED_TOL"]
 
 HEIGHT_TOL = 0.06
 SPEED_TOL = 0.5
@@ -134,3 +137,57 @@ def two_bone_ik(hip, knee, ankle, goal, thigh_rot, shin_rot, fallback_normal):
     thigh = swing(k_off, new_knee - hip) @ thigh_rot
     shin = swing(ankle - knee, new_ankle - new_knee) @ shin_rot
     return thigh, shin
+
+
+def clean_feet(skeleton, tgt, rot, mats, contact, feet, times, mapped):
+    """Hold each contact where it was on average (the ankle moves the foot, the foot turns
+    about the ankle to put the toe on its pin while both touch), keep every foot point above
+    its rest height, and solve the legs for the new ankles (two-bone IK)."""
+    rot = rot.copy()
+    pts = mats[:, feet][..., :3, 3]
+    rest_pts = tgt.mats[feet, :3, 3]
+    dt = float(np.median(np.diff(times))) if len(times) > 1 else 1 / 30
+    offsets, weights = pin_offsets(pts, contact, rest_pts[:, 1], max(2, int(round(0.1 / dt))))
+    hips_rot = rot[:, tgt.slots["hips"]]
+    for side, (ankle_i, toe_i) in (("L", (0, 2)), ("R", (1, 3))):
+        wa, wt = weights[:, ankle_i, None], weights[:, toe_i, None]
+        da, dtoe = offsets[:, ankle_i], offsets[:, toe_i]
+        delta = wa * da + (1 - wa) * wt * dtoe
+        ankle, toe = pts[:, ankle_i], pts[:, toe_i]
+        goal = ankle + delta
+        foot_j, toe_j = feet[ankle_i], feet[toe_i]
+        turn = np.broadcast_to(np.eye(3), (len(times), 3, 3))
+        if toe_j != foot_j:
+            want_toe = toe + delta + wt * (dtoe - delta)
+            turn = swing(toe - ankle, want_toe - goal)
+            for k in skeleton.subtree(foot_j):
+                rot[:, k] = turn @ rot[:, k]
+        # no foot point (ankle, toe, toe tip) below its rest height
+        low = [goal[:, 1], (goal + np.einsum("fab,fb->fa", turn, toe - ankle))[:, 1]]
+        rest_low = [rest_pts[ankle_i, 1], rest_pts[toe_i, 1]]
+        tip = tail_point(skeleton, mats, toe_j)
+        if tip is not None:
+            low.append((goal + np.einsum("fab,fb->fa", turn, tip - ankle))[:, 1])
+            rest_low.append(tail_point(skeleton, tgt.mats[None], toe_j)[0, 1])
+        lift = np.max(np.maximum(0.0, np.array(rest_low)[None] - np.stack(low, axis=1)), axis=1)
+        goal[:, 1] += lift
+        th, sh = tgt.slots[f"thigh_{side}"], tgt.slots[f"shin_{side}"]
+        normal = hips_rot @ (rotations_of(tgt.mats)[tgt.slots["hips"]].T @ tgt.left)
+        rot[:, th], rot[:, sh] = two_bone_ik(
+            mats[:, th, :3, 3], mats[:, sh, :3, 3], ankle, goal, rot[:, th], rot[:, sh],
+            normal)
+    # joints the map leaves out in the legs keep their rest pose below the turned ones
+    rest_rot = Rotation.from_quat(skeleton.rest_rotation).as_matrix()
+    for side in "LR":
+        for j in skeleton.subtree(tgt.slots[f"thigh_{side}"])[1:]:
+            if j not in mapped:
+                rot[:, j] = rot[:, skeleton.parents[j]] @ rest_rot[j]
+    return rot
+
+
+def tail_point(skeleton, mats, j):
+    """(F, 3) model position of joint ``j``'s tail, or None when it has none."""
+    if not np.all(np.isfinite(skeleton.tails[j])):
+        return None
+    local = skeleton.inverse_bind_matrices[j] @ np.r_[skeleton.tails[j], 1.0]
+    return (mats[:, j] @ local)[:, :3]

@@ -28,7 +28,8 @@ from scipy.spatial.transform import Rotation
 
 from ..animation.clip import Clip, Track
 from .calibrate import calibrate, model_stack, rotations_of, swing, unit
-from .contacts import detect_contacts, pin_offsets, two_bone_ik
+from .chains import distribute_bend
+from .contacts import clean_feet as hold_feet, detect_contacts
 from .name_map import auto_map
 
 __all__ = ["retarget", "retarget_result", "RetargetResult"]
@@ -236,7 +237,7 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
             r = swing(r @ u, want) @ r
             pairs.append((j, t_spec, s, s_spec))
         rot[:, j] = r
-    _distribute(tsk, tgt, rot, inverse)
+    distribute_bend(tsk, tgt, rot, inverse)
     scale = tgt.hip_height / src.hip_height
     hips_s = smats[:, inverse[tgt.slots["hips"]], :3, 3]
     hips_t = hips_s * scale
@@ -248,50 +249,12 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
         tgt.slots.get(k, tgt.slots[f]) for k, f in (("toe_L", "foot_L"), ("toe_R", "foot_R"))]
     mats = raw
     if clean_feet:
-        rot = _clean_feet(tsk, tgt, rot, raw, contact, tgt_feet, times, inverse)
+        rot = hold_feet(tsk, tgt, rot, raw, contact, tgt_feet, times, inverse)
         mats = _assemble(tsk, rot, tgt.slots["hips"], hips_t)
     clip = _to_clip(tsk, mats, rot, times, name or source_clip.name, source_clip,
                     tgt.slots["hips"])
     return RetargetResult(clip, dict(map), src, tgt, facing, scale, times, smats, raw, mats,
                           contact, s_floor, pairs)
-
-
-def _distribute(skeleton, tgt, rot, mapped):
-    """Share the bend between two mapped spine or neck joints with the unmapped joints
-    between them (a source spine of 2 joints onto a target of 3), in place.
-
-    With ``a`` and ``b`` consecutive mapped joints of the chain and ``k`` unmapped joints
-    between, ``D`` is ``b``'s turn beyond its calibration relation to ``a``; the ``i``-th joint
-    between takes ``D^(i/(k+1))`` (so the bend is spread and ``b`` keeps its orientation).
-    Unless ``a`` is the hips (whose orientation is the whole body's), one swing at ``a`` then
-    re-aims ``a -> b`` where it pointed.
-    """
-    cal = rotations_of(tgt.mats)
-    for chain in (tgt.chains["spine"], [tgt.slots["chest"]] + tgt.chains["neck"]):
-        marks = [i for i, j in enumerate(chain) if j in mapped]
-        for i0, i1 in zip(marks[:-1], marks[1:]):
-            a, b, run = chain[i0], chain[i1], chain[i0 + 1:i1]
-            if not run:
-                continue
-            rigid = rot[:, a] @ (cal[a].T @ cal[b])
-            delta = Rotation.from_matrix(rot[:, b] @ np.swapaxes(rigid, -1, -2)).as_rotvec()
-            before = _chain_vector(skeleton, rot, run + [b])
-            n = len(run) + 1
-            for k, j in enumerate(run, 1):
-                step = Rotation.from_rotvec(delta * (k / n)).as_matrix()
-                rot[:, j] = step @ rot[:, a] @ (cal[a].T @ cal[j])
-            if a != tgt.slots["hips"]:
-                turn = swing(_chain_vector(skeleton, rot, run + [b]), before)
-                for j in [a] + run:
-                    rot[:, j] = turn @ rot[:, j]
-
-
-def _chain_vector(skeleton, rot, joints):
-    """(F, 3) model vector from the parent of ``joints[0]`` to ``joints[-1]`` through each
-    joint's rest offset, each turned by its parent's model rotation."""
-    return sum(rot[:, skeleton.parents[j]] @ (skeleton.rest_translation[j]
-                                             * skeleton.rest_scale[skeleton.parents[j]])
-               for j in joints)
 
 
 def _pitch(v):
@@ -327,60 +290,6 @@ def _assemble(skeleton, rot, hips, hips_pos):
         else:
             mats[:, j, :3, 3] = skeleton.rest_translation[j]
     return mats
-
-
-def _clean_feet(skeleton, tgt, rot, mats, contact, feet, times, mapped):
-    """Hold each contact where it was on average (the ankle moves the foot, the foot turns
-    about the ankle to put the toe on its pin while both touch), keep every foot point above
-    its rest height, and solve the legs for the new ankles (two-bone IK)."""
-    rot = rot.copy()
-    pts = mats[:, feet][..., :3, 3]
-    rest_pts = tgt.mats[feet, :3, 3]
-    dt = float(np.median(np.diff(times))) if len(times) > 1 else 1 / 30
-    offsets, weights = pin_offsets(pts, contact, rest_pts[:, 1], max(2, int(round(0.1 / dt))))
-    hips_rot = rot[:, tgt.slots["hips"]]
-    for side, (ankle_i, toe_i) in (("L", (0, 2)), ("R", (1, 3))):
-        wa, wt = weights[:, ankle_i, None], weights[:, toe_i, None]
-        da, dtoe = offsets[:, ankle_i], offsets[:, toe_i]
-        delta = wa * da + (1 - wa) * wt * dtoe
-        ankle, toe = pts[:, ankle_i], pts[:, toe_i]
-        goal = ankle + delta
-        foot_j, toe_j = feet[ankle_i], feet[toe_i]
-        turn = np.broadcast_to(np.eye(3), (len(times), 3, 3))
-        if toe_j != foot_j:
-            want_toe = toe + delta + wt * (dtoe - delta)
-            turn = swing(toe - ankle, want_toe - goal)
-            for k in skeleton.subtree(foot_j):
-                rot[:, k] = turn @ rot[:, k]
-        # no foot point (ankle, toe, toe tip) below its rest height
-        low = [goal[:, 1], (goal + np.einsum("fab,fb->fa", turn, toe - ankle))[:, 1]]
-        rest_low = [rest_pts[ankle_i, 1], rest_pts[toe_i, 1]]
-        tip = _tail_point(skeleton, mats, toe_j)
-        if tip is not None:
-            low.append((goal + np.einsum("fab,fb->fa", turn, tip - ankle))[:, 1])
-            rest_low.append(_tail_point(skeleton, tgt.mats[None], toe_j)[0, 1])
-        lift = np.max(np.maximum(0.0, np.array(rest_low)[None] - np.stack(low, axis=1)), axis=1)
-        goal[:, 1] += lift
-        th, sh = tgt.slots[f"thigh_{side}"], tgt.slots[f"shin_{side}"]
-        normal = hips_rot @ (rotations_of(tgt.mats)[tgt.slots["hips"]].T @ tgt.left)
-        rot[:, th], rot[:, sh] = two_bone_ik(
-            mats[:, th, :3, 3], mats[:, sh, :3, 3], ankle, goal, rot[:, th], rot[:, sh],
-            normal)
-    # joints the map leaves out in the legs keep their rest pose below the turned ones
-    rest_rot = Rotation.from_quat(skeleton.rest_rotation).as_matrix()
-    for side in "LR":
-        for j in skeleton.subtree(tgt.slots[f"thigh_{side}"])[1:]:
-            if j not in mapped:
-                rot[:, j] = rot[:, skeleton.parents[j]] @ rest_rot[j]
-    return rot
-
-
-def _tail_point(skeleton, mats, j):
-    """(F, 3) model position of joint ``j``'s tail, or None when it has none."""
-    if not np.all(np.isfinite(skeleton.tails[j])):
-        return None
-    local = skeleton.inverse_bind_matrices[j] @ np.r_[skeleton.tails[j], 1.0]
-    return (mats[:, j] @ local)[:, :3]
 
 
 def _to_clip(skeleton, mats, rot, times, name, source_clip, hips):
