@@ -326,3 +326,16 @@ def test_rigging_imports_no_gui():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.strip()
     assert out == ""
+
+
+def test_clip_plays_the_result_and_root_carries_travel(humanoid):
+    """The clip's forward kinematics give the result's joints; the humanoid's ground-level
+    root carries the horizontal travel (as in the bundled walk), the hips the rest."""
+    res = retarget_result(_load(WALK), "take", humanoid)
+    sk = humanoid.skeleton
+    for f in (0, len(res.times) // 2, len(res.times) - 1):
+        got = sk.forward(res.clip.sample(res.times[f]).local_matrices())[:, :3, 3]
+        assert np.abs(got - res.mats[f, :, :3, 3])[1:].max() < 1e-9  # root: below
+    root = res.clip.tracks[("root", "translation")].values
+    assert np.allclose(root[:, 1], 0.0)
+    assert np.linalg.norm(root[-1] - root[0]) > 0.5  # about one stride of the Bandai walk

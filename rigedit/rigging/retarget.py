@@ -252,7 +252,7 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
         rot = hold_feet(tsk, tgt, rot, raw, contact, tgt_feet, times, inverse)
         mats = _assemble(tsk, rot, tgt.slots["hips"], hips_t)
     clip = _to_clip(tsk, mats, rot, times, name or source_clip.name, source_clip,
-                    tgt.slots["hips"])
+                    tgt.slots["hips"], tgt.points[tgt.slots["hips"]])
     return RetargetResult(clip, dict(map), src, tgt, facing, scale, times, smats, raw, mats,
                           contact, s_floor, pairs)
 
@@ -292,9 +292,11 @@ def _assemble(skeleton, rot, hips, hips_pos):
     return mats
 
 
-def _to_clip(skeleton, mats, rot, times, name, source_clip, hips):
+def _to_clip(skeleton, mats, rot, times, name, source_clip, hips, hips_rest):
     """Local keys from model matrices: a rotation track per joint whose rotation moves, a
-    translation track for the hips."""
+    translation track for the hips; when the hips hang from a non-deforming root (a
+    ground-level carrier, as the bundled characters have), the root carries the horizontal
+    travel, as in the bundled walks (the recorder's camera follows it)."""
     tracks = {}
     nj = len(skeleton)
     for j in range(nj):
@@ -306,6 +308,13 @@ def _to_clip(skeleton, mats, rot, times, name, source_clip, hips):
         tracks[(skeleton.names[j], "rotation")] = Track("rotation", times, quats, "slerp")
     p = skeleton.parents[hips]
     world = np.c_[mats[:, hips, :3, 3], np.ones(len(times))]
+    if p >= 0 and skeleton.parents[p] < 0 and not skeleton.deform[p]:
+        travel = (world[:, :3] - hips_rest) * [1.0, 0.0, 1.0]
+        carried = skeleton.rest_translation[p] + travel
+        mats = mats.copy()
+        mats[:, p, :3, 3] = carried
+        tracks[(skeleton.names[p], "translation")] = Track("translation", times, carried,
+                                                           "linear")
     local_t = world[:, :3] if p < 0 else np.einsum("fab,fb->fa", np.linalg.inv(mats[:, p]),
                                                    world)[:, :3]
     tracks[(skeleton.names[hips], "translation")] = Track("translation", times, local_t,
