@@ -212,3 +212,28 @@ def test_painted_weights_save_into_the_rig_folder_and_export_to_gltf(window, qtb
     assert len(back.vertices) == len(d.rig.vertices)
     cols = [back.skeleton.index[n] for n in d.skeleton.names]
     np.testing.assert_allclose(back.binding.dense()[:, cols], painted, atol=1e-6)
+
+
+def test_plain_click_in_the_weights_view_shows_a_vertex_when_the_brush_is_off(demo_window,
+                                                                              qtbot):
+    w = demo_window
+    d = w.document
+    w.set_gizmos_visible(False)
+    w.set_weights_view(True)
+    assert not w.weight_brush.enabled
+    xy = np.round(display(w, d.skeleton.bind_matrices[4, :3, 3]))
+    depth = len(d.undo_stack)
+    mouse(w.plotter, "press", xy)
+    mouse(w.plotter, "release", xy)
+    assert len(d.undo_stack) == depth
+    hit, _ = surface_hit(w, xy)
+    pts = np.asarray(w.scene.mesh.points, dtype=float)
+    v = int(np.argmin(np.linalg.norm(pts - hit, axis=1)))
+    assert w.info_panel.labels["Vertex"].text().splitlines()[0] == f"#{v:,}"
+    # a drag is a camera turn, not a click: the row keeps the vertex shown before
+    w.info_panel.show_vertex(None, [])
+    mouse(w.plotter, "press", xy)
+    for k in range(1, 4):
+        mouse(w.plotter, "move", xy + [8 * k, 0])
+    mouse(w.plotter, "release", xy + [24, 0])
+    assert w.info_panel.labels["Vertex"].text() == "-"

@@ -234,7 +234,7 @@ class FileActions:
             self.w.status(f"Recomputed weights for {len(vertices):,} vertices")
 
         return self.w.run_job("Computing weights",
-                              lambda report: weights_in_chunks(vertices, skeleton, method,
+                              lambda report: weights_in_chunks(vertices, skeleton, method=method,
                                                                report=report,
                                                                faces=rig.faces), done)
 

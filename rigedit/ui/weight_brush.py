@@ -6,7 +6,8 @@ one dab where the mouse ray meets the shown (skinned) surface, and the release m
 stroke one undo step (:meth:`Document.set_weights`). The brush radius is in screen pixels:
 at each dab it becomes scene units at the depth of the surface point under the mouse, and the
 vertices within that distance of the point are painted with a smooth falloff. A Ctrl+click on
-the mesh paints nothing and shows the nearest vertex's influences in the info panel.
+the mesh paints nothing and shows the nearest vertex's influences in the info panel; so does a
+plain click (no drag) in the weight paint view while the brush is off.
 
 The press, move and release observers sit on the VTK interactor at a priority between the
 axis handles' and the joint spheres' and abort the events they take, so the camera does not
@@ -128,7 +129,7 @@ class WeightBrush:
         self.locked = set()
         self.stroke = None
         self._cache = {}
-        self._last_xy = None
+        self._click = None  # (x, y, vertex) of a press that may become a plain click
         self._build_circle()
         iren = window.plotter.iren.interactor
         self._iren = iren
@@ -136,6 +137,9 @@ class WeightBrush:
                            for event, fn in (("LeftButtonPressEvent", self._press),
                                              ("MouseMoveEvent", self._move),
                                              ("LeftButtonReleaseEvent", self._release))]
+        tag = iren.AddObserver("LeftButtonReleaseEvent", self._click_release, self.PRIORITY)
+        iren.GetCommand(tag).SetPassiveObserver(1)
+        self._passive = [tag]
         panel.lock_toggled.connect(self._lock_selected)
         window.document.subscribe(self._on_document)
         self._attach()
@@ -240,6 +244,9 @@ class WeightBrush:
             self.show_vertex(self.nearest_vertex(hit))
             return True
         if not self._active():
+            if self.w._weights_view:  # a plain click (no drag) in the view shows a vertex
+                hit = self.pick(x, y)
+                self._click = None if hit is None else (x, y, self.nearest_vertex(hit))
             return False
         hit = self.pick(x, y)
         if hit is None:
@@ -260,7 +267,6 @@ class WeightBrush:
 
     def _move(self, iren):
         x, y = iren.GetEventPosition()
-        self._last_xy = (x, y)
         if self.stroke is None:
             if self._active():
                 self._show_circle(x, y, self.pick(x, y) is not None)
@@ -277,6 +283,17 @@ class WeightBrush:
             return False
         self.finish()
         return True
+
+    def _click_release(self, iren, _event):
+        """A passive observer: the camera style grabs the interactor's focus on a press it
+        takes, and then only passive observers see the release."""
+        click, self._click = self._click, None
+        try:
+            if click is not None and self.stroke is None and np.hypot(
+                    *np.subtract(iren.GetEventPosition(), click[:2])) <= 3:
+                self.show_vertex(click[2])
+        except Exception:  # noqa: BLE001 - VTK would swallow it; show it
+            self.w.report_exception("Weight brush")
 
     # ------------------------------------------------------------------ picking
     def pick(self, x, y):
@@ -430,9 +447,9 @@ class WeightBrush:
         self.w.status(f"Vertex {v}: " + ", ".join(f"{n} {w:.3f}" for n, w in pairs))
 
     def remove(self):
-        for tag in self._observers:
+        for tag in self._observers + self._passive:
             self._iren.RemoveObserver(tag)
-        self._observers = []
+        self._observers = self._passive = []
 
 
 def install_weight_brush(window):
