@@ -324,3 +324,16 @@ def test_texture_from_an_image_file_or_data_uri(tmp_path, where):
     assert mat.texture.shape == (4, 8, 4) and mat.mime == "image/png" and mat.image_bytes == png
     assert tuple(mat.texture[0, 0]) == (255, 0, 0, 255) and tuple(mat.texture[3, 0]) == (0, 0, 255, 255)
     np.testing.assert_allclose(rig.surface.uvs, np.tile([[0.5, 0.25]], (8, 1)))
+
+
+def test_several_skins_take_the_first_with_a_mesh(tmp_path):
+    b, _ = two_bone()
+    # a skin with no mesh first, then the bar's skin (now skin 1)
+    b.doc["skins"].insert(0, {"joints": [2]})
+    b.doc["nodes"][0]["skin"] = 1
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rig = load_gltf(b.write(tmp_path / "a.glb"))
+    msgs = [str(w.message) for w in caught if issubclass(w.category, GltfWarning)]
+    assert len(msgs) == 1 and "2 skins; using skin 1" in msgs[0]
+    assert rig.skeleton.names == ["root", "tip"] and len(rig.vertices) == 8
