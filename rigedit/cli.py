@@ -120,7 +120,7 @@ def check_options(args):
 
 
 def cmd_render(args):
-    from .cli_output import check_interrupted
+    from .cli_output import check_interrupted, deferred
     from .render.recorder import record_clip
 
     size = _parse_size(args.size)
@@ -148,10 +148,11 @@ def cmd_render(args):
 
     t0 = time.perf_counter()
     try:
-        n = record_clip(rig, clip, args.output, fps=args.fps, duration=args.duration,
-                        size=size, angle=args.angle, view=args.view,
-                        show_skeleton=args.skeleton, progress=progress,
-                        skinning=args.skinning)
+        with deferred():   # a signal stops the render between frames (see cli_output)
+            n = record_clip(rig, clip, args.output, fps=args.fps, duration=args.duration,
+                            size=size, angle=args.angle, view=args.view,
+                            show_skeleton=args.skeleton, progress=progress,
+                            skinning=args.skinning)
     finally:
         if bar is not None:
             bar.close()

@@ -6,9 +6,10 @@ written when the run is interrupted.
 - :func:`interruptible` turns SIGINT (Ctrl-C) and SIGTERM into an :class:`Interrupted`
   exception, so the writers' clean-up (``finally`` blocks that delete their temporary file)
   runs; the command then prints one line and exits with 128 + the signal number (130, 143).
-  Long jobs call :func:`check_interrupted` between steps: an exception raised while Python
-  code ran inside a VTK callback is swallowed there, and would otherwise leave the job
-  running.
+  Within :func:`deferred` (rendering) a signal is only recorded, and the job raises it at
+  its next step with :func:`check_interrupted`: an exception raised while Python code runs
+  inside VTK (a ``vtkPythonAlgorithm``) is printed and swallowed there, and one raised while
+  imageio starts ffmpeg can leave ffmpeg to create the temporary file after the clean-up.
 """
 from __future__ import annotations
 
@@ -20,10 +21,12 @@ from pathlib import Path
 from .errors import RigFileError
 from .io.atomic import check_output_folder
 
-__all__ = ["Interrupted", "interruptible", "check_interrupted", "check_output"]
+__all__ = ["Interrupted", "interruptible", "check_interrupted", "deferred", "check_output"]
 
 #: Signals received within :func:`interruptible`, oldest first.
 _received = []
+#: True within :func:`deferred`.
+_deferring = [False]
 
 
 class Interrupted(BaseException):
@@ -43,15 +46,25 @@ def _raise_interrupted(signum, frame):
     # Only the first signal raises: a second Ctrl-C must not break into the clean-up that the
     # first one started (and leave the temporary file behind).
     _received.append(signum)
-    if len(_received) == 1:
+    if len(_received) == 1 and not _deferring[0]:
         raise Interrupted(signum)
 
 
 def check_interrupted():
-    """Raise :class:`Interrupted` again when a signal came (its first exception may have been
-    swallowed by a VTK callback)."""
+    """Raise :class:`Interrupted` when a signal came (held by :func:`deferred`, or raised
+    once and swallowed by a VTK callback)."""
     if _received:
         raise Interrupted(_received[0])
+
+
+@contextlib.contextmanager
+def deferred():
+    """Within the block, SIGINT and SIGTERM only take effect at :func:`check_interrupted`."""
+    _deferring[0] = True
+    try:
+        yield
+    finally:
+        _deferring[0] = False
 
 
 @contextlib.contextmanager

@@ -146,22 +146,29 @@ def test_interrupted_render_removes_its_temporary_file(rig_dir, tmp_path):
     cases = [(signal.SIGINT, ".mp4", True, 0.5), (signal.SIGTERM, ".gif", False, 0.5),
              (signal.SIGTERM, ".mp4", False, 0.5), (signal.SIGINT, ".mp4", True, 0.0)]
     runs = []
-    for i, (sig, suffix, group, delay) in enumerate(cases):   # together: startup dominates
-        out = tmp_path / f"out{i}" / f"v{suffix}"
-        out.parent.mkdir()
-        runs.append((sig, group, delay, out, _start_render(rig_dir, out)))
-    for sig, group, delay, out, proc in runs:
-        deadline = time.monotonic() + 120
-        while not _hidden(out.parent) and proc.poll() is None and time.monotonic() < deadline:
-            time.sleep(0.01)
-        assert proc.poll() is None and _hidden(out.parent), "the render did not start writing"
-        time.sleep(delay)
-        (os.killpg if group else os.kill)(proc.pid, sig)
-    for sig, group, delay, out, proc in runs:
-        _, err = proc.communicate(timeout=60)
-        assert proc.returncode == 128 + sig
-        assert err.splitlines() == [f"rigedit: interrupted by {signal.Signals(sig).name}"], err
-        assert list(out.parent.iterdir()) == []   # no temporary file, no output
+    try:
+        for i, (sig, suffix, group, delay) in enumerate(cases):   # together: startup dominates
+            out = tmp_path / f"out{i}" / f"v{suffix}"
+            out.parent.mkdir()
+            runs.append((sig, group, delay, out, _start_render(rig_dir, out)))
+        for sig, group, delay, out, proc in runs:
+            deadline = time.monotonic() + 120
+            while (not _hidden(out.parent) and proc.poll() is None
+                   and time.monotonic() < deadline):
+                time.sleep(0.01)
+            assert proc.poll() is None and _hidden(out.parent), "the render did not start"
+            time.sleep(delay)
+            (os.killpg if group else os.kill)(proc.pid, sig)
+        for sig, group, delay, out, proc in runs:
+            _, err = proc.communicate(timeout=60)
+            assert proc.returncode == 128 + sig
+            assert err.splitlines() == [f"rigedit: interrupted by {signal.Signals(sig).name}"]
+            assert list(out.parent.iterdir()) == []   # no temporary file, no output
+    finally:   # a failed run must not leave renders going for minutes
+        for *_, proc in runs:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
 
 
 def test_a_folder_that_refuses_the_temporary_file_is_reported_as_the_target(tmp_path,
