@@ -83,11 +83,10 @@ def _first_hit_py(orig, end, skip, tv, p0, e1, e2, lo, hi, left, bmin, bmax, t_l
                   front, any_hit, out):
     """Loop kernel of :meth:`SurfaceRays.first_hit` (numba-compiled when available).
 
-    Rays go in blocks of ``BLOCK``, one traversal stack per block; blocks run in parallel
-    when compiled (``prange``).
+    Rays go in blocks of ``BLOCK``, one traversal stack per block.
     """
     nblocks = (orig.shape[0] + BLOCK - 1) // BLOCK
-    for blk in _prange(nblocks):
+    for blk in range(nblocks):
         _block(blk * BLOCK, min(orig.shape[0], (blk + 1) * BLOCK), orig, end, skip, tv, p0,
                e1, e2, lo, hi, left, bmin, bmax, t_lo, t_hi, front, any_hit, out)
     return out
@@ -161,8 +160,10 @@ def _block_py(r0, r1, orig, end, skip, tv, p0, e1, e2, lo, hi, left, bmin, bmax,
 if HAVE_NUMBA:
     _build = numba.njit(cache=True)(_build_py)
     _block = numba.njit(cache=True, nogil=True)(_block_py)
-    _prange = numba.prange
-    _first_hit = numba.njit(cache=True, nogil=True, parallel=True)(_first_hit_py)
+    # Serial on purpose: numba's default (workqueue) threading layer refuses a parallel
+    # kernel launched from two threads at once, and the editor runs weights in a worker
+    # thread while its skinning kernels run on the main thread. nogil lets the UI run.
+    _first_hit = numba.njit(cache=True, nogil=True)(_first_hit_py)
 else:  # pragma: no cover
     _build = _build_py
     _first_hit = None
