@@ -126,7 +126,7 @@ def results():
 @pytest.mark.parametrize("src,tgt", COMBOS, ids=lambda p: Path(str(p)).stem)
 def test_bone_directions_agree(src, tgt, results):
     """Measured (benchmarks/bench_retarget.py): arms, spine and head 0.0 degrees on average,
-    legs 0.9-3.4 (the leg IK moves thighs and shins while it holds the feet)."""
+    legs 1.5-4.4 (the leg IK moves thighs and shins while it holds the feet)."""
     res = results(src, tgt)
     err = direction_errors(res)
     for group in ("arms", "spine", "head"):
@@ -142,7 +142,7 @@ def test_contacts_slip_less_and_feet_above_floor(src, tgt, results):
     assert res.contact.any(axis=0).all(), "every foot point touches the ground at some time"
     before = foot_slip(target_foot_points(res, res.raw_mats), res.contact).mean()
     after = foot_slip(target_foot_points(res), res.contact).mean()
-    assert after < 0.5 * before, (before, after)  # measured after / before: 0.04-0.31
+    assert after < 0.2 * before, (before, after)  # measured after / before: 0.000-0.034
     assert lowest_foot(res) > -1e-3
     assert lowest_foot(res, res.raw_mats) < lowest_foot(res) or lowest_foot(res) < 0.05
 

@@ -142,13 +142,23 @@ def two_bone_ik(hip, knee, ankle, goal, thigh_rot, shin_rot, fallback_normal):
 def clean_feet(skeleton, tgt, rot, mats, contact, feet, times, mapped):
     """Hold each contact where it was on average (the ankle moves the foot, the foot turns
     about the ankle to put the toe on its pin while both touch), keep every foot point above
-    its rest height, and solve the legs for the new ankles (two-bone IK)."""
+    its rest height, lower the hips where a stretched leg falls short, and solve the legs for
+    the new ankles (two-bone IK).
+
+    Returns
+    -------
+    rot : (F, J, 3, 3) float64
+        New model rotations.
+    drop : (F,) float64
+        How far to lower the hips in each frame.
+    """
     rot = rot.copy()
     pts = mats[:, feet][..., :3, 3]
     rest_pts = tgt.mats[feet, :3, 3]
     dt = float(np.median(np.diff(times))) if len(times) > 1 else 1 / 30
-    offsets, weights = pin_offsets(pts, contact, rest_pts[:, 1], max(2, int(round(0.1 / dt))))
-    hips_rot = rot[:, tgt.slots["hips"]]
+    blend = max(2, int(round(0.1 / dt)))
+    offsets, weights = pin_offsets(pts, contact, rest_pts[:, 1], blend)
+    goals = {}
     for side, (ankle_i, toe_i) in (("L", (0, 2)), ("R", (1, 3))):
         wa, wt = weights[:, ankle_i, None], weights[:, toe_i, None]
         da, dtoe = offsets[:, ankle_i], offsets[:, toe_i]
@@ -159,6 +169,10 @@ def clean_feet(skeleton, tgt, rot, mats, contact, feet, times, mapped):
         turn = np.broadcast_to(np.eye(3), (len(times), 3, 3))
         if toe_j != foot_j:
             want_toe = toe + delta + wt * (dtoe - delta)
+            # the two pins are means over different frames, so their distance is not quite
+            # the foot's length: the toe keeps its pin, the ankle comes as close as it can
+            length = np.linalg.norm(toe - ankle, axis=1, keepdims=True)
+            goal = goal + wt * (want_toe - length * unit(want_toe - goal) - goal)
             turn = swing(toe - ankle, want_toe - goal)
             for k in skeleton.subtree(foot_j):
                 rot[:, k] = turn @ rot[:, k]
@@ -171,18 +185,47 @@ def clean_feet(skeleton, tgt, rot, mats, contact, feet, times, mapped):
             rest_low.append(tail_point(skeleton, tgt.mats[None], toe_j)[0, 1])
         lift = np.max(np.maximum(0.0, np.array(rest_low)[None] - np.stack(low, axis=1)), axis=1)
         goal[:, 1] += lift
+        goals[side] = (ankle, goal)
+    # Where a stretched leg cannot reach its goal, lower the hips by the shortfall (spread
+    # over the blend window so the body does not jolt).
+    drop = np.zeros(len(times))
+    for side, (ankle, goal) in goals.items():
         th, sh = tgt.slots[f"thigh_{side}"], tgt.slots[f"shin_{side}"]
-        normal = hips_rot @ (rotations_of(tgt.mats)[tgt.slots["hips"]].T @ tgt.left)
+        hip = mats[:, th, :3, 3]
+        reach = 0.999 * (np.linalg.norm(mats[:, sh, :3, 3] - hip, axis=1)
+                         + np.linalg.norm(ankle - mats[:, sh, :3, 3], axis=1))
+        v = goal - hip
+        horiz = np.linalg.norm(v[:, [0, 2]], axis=1)
+        # hip height above the goal at which the goal is just in reach
+        ok_height = np.sqrt(np.maximum(reach ** 2 - horiz ** 2, 0.0))
+        drop = np.maximum(drop, np.maximum(0.0, -v[:, 1] - ok_height))
+    if drop.any():
+        drop = _smooth_max(drop, blend)
+    hips_rot = rot[:, tgt.slots["hips"]]
+    normal = hips_rot @ (rotations_of(tgt.mats)[tgt.slots["hips"]].T @ tgt.left)
+    for side, (ankle, goal) in goals.items():
+        th, sh = tgt.slots[f"thigh_{side}"], tgt.slots[f"shin_{side}"]
+        down = np.c_[np.zeros(len(times)), drop, np.zeros(len(times))]
         rot[:, th], rot[:, sh] = two_bone_ik(
-            mats[:, th, :3, 3], mats[:, sh, :3, 3], ankle, goal, rot[:, th], rot[:, sh],
-            normal)
+            mats[:, th, :3, 3] - down, mats[:, sh, :3, 3] - down, ankle - down, goal,
+            rot[:, th], rot[:, sh], normal)
     # joints the map leaves out in the legs keep their rest pose below the turned ones
     rest_rot = Rotation.from_quat(skeleton.rest_rotation).as_matrix()
     for side in "LR":
         for j in skeleton.subtree(tgt.slots[f"thigh_{side}"])[1:]:
             if j not in mapped:
                 rot[:, j] = rot[:, skeleton.parents[j]] @ rest_rot[j]
-    return rot
+    return rot, drop
+
+
+def _smooth_max(x, width):
+    """A running maximum over ``2 width + 1`` samples, then a moving average as wide: covers
+    every sample's need and ramps in and out."""
+    pad = np.pad(x, width, mode="edge")
+    windows = np.lib.stride_tricks.sliding_window_view(pad, 2 * width + 1)
+    peak = windows.max(axis=1)
+    kernel = np.ones(2 * width + 1) / (2 * width + 1)
+    return np.maximum(np.convolve(np.pad(peak, width, mode="edge"), kernel, mode="valid"), x)
 
 
 def tail_point(skeleton, mats, j):

@@ -249,7 +249,8 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
         tgt.slots.get(k, tgt.slots[f]) for k, f in (("toe_L", "foot_L"), ("toe_R", "foot_R"))]
     mats = raw
     if clean_feet:
-        rot = hold_feet(tsk, tgt, rot, raw, contact, tgt_feet, times, inverse)
+        rot, drop = hold_feet(tsk, tgt, rot, raw, contact, tgt_feet, times, inverse)
+        hips_t = hips_t - np.c_[np.zeros_like(drop), drop, np.zeros_like(drop)]
         mats = _assemble(tsk, rot, tgt.slots["hips"], hips_t)
     clip = _to_clip(tsk, mats, rot, times, name or source_clip.name, source_clip,
                     tgt.slots["hips"], tgt.points[tgt.slots["hips"]])
