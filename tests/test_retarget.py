@@ -339,3 +339,12 @@ def test_clip_plays_the_result_and_root_carries_travel(humanoid):
     root = res.clip.tracks[("root", "translation")].values
     assert np.allclose(root[:, 1], 0.0)
     assert np.linalg.norm(root[-1] - root[0]) > 0.5  # about one stride of the Bandai walk
+
+
+def test_api_retarget_returns_a_clip_of_the_target(humanoid):
+    clip = rigedit.retarget(_load(RUN), "take", humanoid, name="bandai_run")
+    assert isinstance(clip, rigedit.Clip) and clip.name == "bandai_run"
+    assert clip.skeleton is humanoid.skeleton
+    assert abs(clip.duration - _load(RUN).clips["take"].duration) < 1e-9
+    moving = [j for (j, ch) in clip.tracks if ch == "rotation"]
+    assert {"LeftUpLeg", "RightLeg", "LeftArm", "Spine2", "Head"} <= set(moving)
