@@ -237,3 +237,23 @@ def test_plain_click_in_the_weights_view_shows_a_vertex_when_the_brush_is_off(de
         mouse(w.plotter, "move", xy + [8 * k, 0])
     mouse(w.plotter, "release", xy + [24, 0])
     assert w.info_panel.labels["Vertex"].text() == "-"
+
+
+def test_brush_circle_follows_the_mouse_over_the_mesh_and_hides_when_it_leaves(demo_window,
+                                                                               qtbot):
+    from PyQt5 import QtCore, QtWidgets
+
+    w = demo_window
+    d = w.document
+    start_brush(w, 4, radius=30)
+    circle = w.weight_brush.circle_actor
+    xy = np.round(display(w, d.skeleton.bind_matrices[4, :3, 3]))
+    qt = QtCore.QPoint(int(xy[0]), int(w.plotter.height() - 1 - xy[1]))
+    qtbot.mouseMove(w.plotter, qt)  # no button held: hovering
+    assert circle.GetVisibility()
+    pts = np.array([w.weight_brush.circle.GetPoint(k) for k in range(64)])[:, :2]
+    np.testing.assert_allclose(pts.mean(axis=0), xy, atol=0.5)
+    np.testing.assert_allclose(np.linalg.norm(pts - xy, axis=1), 30, atol=1e-4)  # float32
+    assert len(d.undo_stack) == 0  # hovering paints nothing
+    QtWidgets.QApplication.sendEvent(w.plotter, QtCore.QEvent(QtCore.QEvent.Leave))
+    assert not circle.GetVisibility()

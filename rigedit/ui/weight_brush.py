@@ -62,7 +62,7 @@ class WeightBrush:
                                              ("LeftButtonReleaseEvent", self._release))]
         tag = iren.AddObserver("LeftButtonReleaseEvent", self._click_release, self.PRIORITY)
         iren.GetCommand(tag).SetPassiveObserver(1)
-        self._passive = [tag]
+        self._passive = [tag, iren.AddObserver("LeaveEvent", self._leave)]
         panel.lock_toggled.connect(self._lock_selected)
         window.document.subscribe(self._on_document)
         self._attach()
@@ -206,6 +206,12 @@ class WeightBrush:
             return False
         self.finish()
         return True
+
+    def _leave(self, _iren, _event):
+        """The mouse left the view: no circle where it no longer is."""
+        if self.circle_actor.GetVisibility():
+            self.circle_actor.VisibilityOff()
+            self.w.request_render()
 
     def _click_release(self, iren, _event):
         """A passive observer: the camera style grabs the interactor's focus on a press it
