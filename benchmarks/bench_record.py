@@ -1,9 +1,24 @@
-"""Recording throughput: frames per second of ``record_clip`` at 1280x720.
+"""Recording throughput: frames per second of ``record_clip`` at 1280x720, beside a bare
+off-screen plotter that only skins, draws and reads back the same mesh.
 
 Run under a display (``xvfb-run -a .venv/bin/python benchmarks/bench_record.py``). Uses the
 bundled quadruped's walk (``rigedit.load_rig()``), or a code-built creature when the assets are
-not installed. Prints one line per configuration: the whole recorder (skin, render, read back,
-encode), and the same without the floor or with 4x anti-aliasing, best of ``--repeat`` runs.
+not installed. In one run, ``--repeat`` times in turn (so both see the same load):
+
+* bare: a ``pyvista.Plotter(off_screen=True)`` of the same size, multi-sampling off, pyvista's
+  default lights, the mesh added once with the recorder's material; per frame the same clip
+  sample, ``binding.skin_with_normals`` (positions and normals in one pass) written into the
+  mesh in place, ``render()`` and a read-back of the pixels into a reused buffer
+  (``vtkRenderWindow.GetPixelData``, as ``screenshot`` reads them), no encoding; the camera
+  framed as the recorder frames it;
+* record_clip: the whole recorder (MP4 H.264 veryfast, floor grid, camera follow, encode), its
+  plotter's set-up included.
+
+Prints the best rate, the spread (worst-best) and the process CPU time per frame (this
+process only; ffmpeg runs in its own), then the ratio achieved / bare. ``--configs`` adds the
+older table's other settings (medium preset, no floor, 4x MSAA, GIF). ``--compare-with
+OLD.py`` also times another version of ``rigedit/render/recorder.py`` in the same run (for
+example ``git show COMMIT:rigedit/render/recorder.py > /tmp/old_recorder.py``).
 """
 from __future__ import annotations
 
@@ -29,15 +44,81 @@ def load():
     return rig, clip
 
 
-def run(rig, clip, path, frames, fps, size, repeat, **options):
-    from rigedit.render.recorder import record_clip
+def bare(rig, clip, frames, fps, size):
+    """Frames/s and CPU s/frame of a plotter that skins, draws and reads back the mesh only."""
+    import numpy as np
+    import pyvista as pv
 
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        n = record_clip(rig, clip, path, fps=fps, duration=frames / fps, size=size, **options)
-        best = min(best, time.perf_counter() - t0)
-    return n, n / best, path.stat().st_size
+    from rigedit.model.kinematics import skinning_matrices
+    from rigedit.model.skinning import vertex_normals
+    from rigedit.render.recorder import FrameReader
+    from rigedit.render.scene import MESH_COLOR, faces_to_vtk
+
+    binding = rig.binding
+    binding.bind_normals(vertex_normals(binding.rest_vertices, rig.faces))
+    mesh = pv.PolyData(rig.vertices.astype(np.float32), faces_to_vtk(rig.faces))
+    mesh.point_data.set_array(np.zeros((len(rig.vertices), 3), np.float32), "Normals")
+    mesh.point_data.active_normals_name = "Normals"
+    plotter = pv.Plotter(off_screen=True, window_size=size)
+    try:
+        plotter.disable_anti_aliasing()
+        plotter.add_mesh(mesh, color=MESH_COLOR, smooth_shading=True, specular=0.25,
+                         specular_power=20)
+        pose = rig.rest_pose()
+        times = np.arange(frames) / float(fps)
+        frame_like_the_recorder(plotter, rig, clip, frames, fps)
+        plotter.screenshot(return_img=False)  # pyvista renders only after a first one
+        reader = FrameReader(plotter, buffers=1)
+        t0, c0 = time.perf_counter(), time.process_time()
+        for t in times:
+            if clip is not None:
+                clip.sample(t, out=pose)
+            palette = skinning_matrices(rig.skeleton, rig.joint_matrices(pose))
+            pts, nrm = binding.skin_with_normals(palette)
+            mesh.points[:] = pts
+            mesh.point_data["Normals"][:] = nrm
+            mesh.GetPoints().Modified()
+            mesh.Modified()
+            plotter.render()
+            img = reader.read()
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+        assert img.shape[:2] == (size[1], size[0])
+    finally:
+        plotter.close()
+    return frames / wall, cpu / frames
+
+
+def frame_like_the_recorder(plotter, rig, clip, frames, fps):
+    """The recorder's camera (front view fitted to the vertices the clip sweeps), so both
+    plotters fill the same pixels; the walk's root travel over 2 s is small at that size."""
+    import functools
+    import types
+
+    from rigedit.render.recorder import frame_times, swept_points
+    from rigedit.render.scene import RigScene, front_vector, up_vector
+
+    view = types.SimpleNamespace(plotter=plotter, up=up_vector(rig.up),
+                                 front=front_vector(rig.up))
+    view._fit_distance = functools.partial(RigScene._fit_distance, view)
+    times = frame_times(frames / fps, fps)
+    RigScene.view(view, "front", points=swept_points(rig, clip, times))
+
+
+def recorded(rig, clip, path, frames, fps, size, module=None, **options):
+    if module is None:
+        from rigedit.render.recorder import record_clip
+    else:
+        record_clip = module.record_clip
+    t0, c0 = time.perf_counter(), time.process_time()
+    n = record_clip(rig, clip, path, fps=fps, duration=frames / fps, size=size, **options)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    return n / wall, cpu / n
+
+
+def summary(rates):
+    fps = [r for r, _ in rates]
+    cpu = min(c for _, c in rates)
+    return max(fps), max(fps) - min(fps), cpu
 
 
 def main(argv=None):
@@ -45,27 +126,52 @@ def main(argv=None):
     ap.add_argument("--frames", type=int, default=60)
     ap.add_argument("--fps", type=float, default=30)
     ap.add_argument("--size", type=int, nargs=2, default=(1280, 720))
-    ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--configs", action="store_true", help="also the other settings")
+    ap.add_argument("--compare-with", metavar="RECORDER.py",
+                    help="another version of rigedit/render/recorder.py, timed alongside")
     args = ap.parse_args(argv)
     rig, clip = load()
     size = tuple(args.size)
     print(f"{rig.name}: {len(rig.vertices):,} vertices, {len(rig.faces):,} triangles, "
           f"{len(rig.skeleton)} joints; clip {clip.name if clip else None}; "
-          f"{size[0]}x{size[1]}, {args.frames} frames, best of {args.repeat} (includes the "
-          f"plotter's set-up, about 0.3 s)")
-    configs = [
-        ("MP4 H.264 veryfast (default)", ".mp4", {}),
-        ("MP4 H.264 medium preset", ".mp4", {"preset": "medium"}),
-        ("MP4, no floor", ".mp4", {"show_floor": False}),
-        ("MP4, 4x MSAA", ".mp4", {"multi_samples": 4}),
-        ("GIF", ".gif", {}),
-    ]
+          f"{size[0]}x{size[1]}, {args.frames} frames, {args.repeat} runs each, interleaved; "
+          f"load average {os.getloadavg()[0]:.1f}")
+    configs = [("record_clip MP4 H.264 veryfast", ".mp4", {})]
+    if args.configs:
+        configs += [("record_clip MP4 medium preset", ".mp4", {"preset": "medium"}),
+                    ("record_clip MP4, no floor", ".mp4", {"show_floor": False}),
+                    ("record_clip MP4, 4x MSAA", ".mp4", {"multi_samples": 4}),
+                    ("record_clip GIF", ".gif", {})]
+    if args.compare_with:
+        import importlib.util
+
+        spec = importlib.util.spec_from_file_location("rigedit.render._compared_recorder",
+                                                      args.compare_with)
+        other = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(other)
+        configs.append((f"record_clip of {Path(args.compare_with).name}", ".mp4",
+                        {"module": other}))
+    runs = {label: [] for label in ["bare plotter (skin, draw, read back)"]
+            + [c[0] for c in configs]}
+    bare(rig, clip, 5, args.fps, size)  # warm-up: kernels, GL context
     with tempfile.TemporaryDirectory() as tmp:
-        for label, suffix, options in configs:
-            path = Path(tmp) / f"bench{suffix}"
-            n, fps, nbytes = run(rig, clip, path, args.frames, args.fps, size, args.repeat,
-                                 **options)
-            print(f"  {label:32s} {fps:6.1f} frames/s   ({n} frames, {nbytes / 1e6:.1f} MB)")
+        for _ in range(args.repeat):
+            runs["bare plotter (skin, draw, read back)"].append(
+                bare(rig, clip, args.frames, args.fps, size))
+            for label, suffix, options in configs:
+                path = Path(tmp) / f"bench{suffix}"
+                runs[label].append(recorded(rig, clip, path, args.frames, args.fps, size,
+                                            **options))
+    print(f"  {'':40s} {'best':>7s} {'spread':>7s} {'CPU/frame':>10s}")
+    for label, rates in runs.items():
+        best, spread, cpu = summary(rates)
+        print(f"  {label:40s} {best:7.1f} {spread:7.1f} {cpu * 1e3:8.1f} ms   frames/s")
+    b = summary(runs["bare plotter (skin, draw, read back)"])
+    r = summary(runs[configs[0][0]])
+    print(f"  achieved / bare: {r[0] / b[0]:.2f} (best rates); CPU per frame "
+          f"{r[2] / b[2]:.2f}x the bare plotter's (load average now "
+          f"{os.getloadavg()[0]:.1f})")
 
 
 if __name__ == "__main__":

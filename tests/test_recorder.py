@@ -74,3 +74,69 @@ def test_rejects_bad_arguments(rig, tmp_path):
         record_clip(rig, None, tmp_path / "x.mp4", size=(161, 120))
     with pytest.raises(RigFileError, match="folder"):
         record_clip(rig, None, tmp_path / "missing" / "x.mp4", size=SIZE)
+
+
+def test_an_encoder_error_in_the_writer_thread_is_raised_once_and_leaves_no_temporary(
+        rig, tmp_path, monkeypatch):
+    import threading
+
+    from rigedit.render import recorder
+
+    path = tmp_path / "out.mp4"
+    path.write_bytes(b"old video")
+    real_append, written, done = recorder._Writer.append, [], []
+
+    def failing_append(self, frame):
+        if len(written) == 3:
+            raise OSError("ffmpeg: No space left on device")
+        real_append(self, frame)
+        written.append(frame.shape)
+
+    thread_errors = []
+    monkeypatch.setattr(recorder._Writer, "append", failing_append)
+    monkeypatch.setattr(threading, "excepthook", thread_errors.append)
+    with pytest.raises(OSError, match="No space left on device"):
+        record_clip(rig, rig.clips["bend"], path, fps=10, duration=2.0, size=SIZE,
+                    progress=lambda d, total: done.append(d))
+    assert thread_errors == []          # one error, raised in the caller, none in the thread
+    assert written == [(SIZE[1], SIZE[0], 3)] * 3
+    assert len(done) < 20               # stopped at the next frame handed over, not the end
+    assert path.read_bytes() == b"old video"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.mp4"]
+
+
+def test_cancel_with_frames_queued_keeps_an_existing_gif(rig, tmp_path):
+    path = tmp_path / "out.gif"
+    path.write_bytes(b"old gif")
+    with pytest.raises(RecordingCancelled):
+        record_clip(rig, rig.clips["bend"], path, fps=10, duration=1.0, size=SIZE,
+                    progress=lambda done, total: done < 5)
+    assert path.read_bytes() == b"old gif"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.gif"]
+
+
+def test_frame_reader_reads_what_screenshot_reads(rig):
+    import pyvista as pv
+
+    from rigedit.render.recorder import FrameReader
+    from rigedit.render.scene import RigScene
+
+    plotter = pv.Plotter(off_screen=True, window_size=SIZE)
+    try:
+        plotter.set_background("#eef1f4", top="#c5ccd6")
+        RigScene(plotter, rig, show_skeleton=True)
+        reader = FrameReader(plotter, buffers=2)
+        shot = plotter.screenshot(return_img=True)
+        first = reader.read()
+        assert first.shape == (SIZE[1], SIZE[0], 3)
+        np.testing.assert_array_equal(first, shot)   # same rows, top row first
+        assert shot[0].mean() != shot[-1].mean()     # the gradient: a flip would show
+        kept = first.copy()
+        plotter.camera.Zoom(2.0)                    # the cylinder fills more of the frame
+        plotter.render()
+        second = reader.read()
+        np.testing.assert_array_equal(second, plotter.screenshot(return_img=True))
+        np.testing.assert_array_equal(first, kept)   # the ring did not reuse the first buffer
+        assert np.abs(second.astype(int) - kept).mean() > 0.5
+    finally:
+        plotter.close()

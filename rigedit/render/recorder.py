@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import contextlib
 import os
+import queue
 import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +23,7 @@ from ..io.atomic import check_output_folder, naming_target, temp_beside
 from .scene import RigScene, joint_points, turn_about, up_vector
 
 __all__ = ["record_clip", "frame_times", "camera_state", "apply_camera", "VIDEO_SUFFIXES",
-           "RecordingCancelled"]
+           "RecordingCancelled", "FrameReader"]
 
 VIDEO_SUFFIXES = (".mp4", ".gif")
 
@@ -192,7 +194,10 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         base_focal = np.array(plotter.camera.focal_point)
         root0 = model0[0, :3, 3].copy()
         up = scene.up
-        writer = _Writer(path, fps, quality, preset)
+        writer = _ThreadedWriter(_Writer(path, fps, quality, preset))
+        reader = FrameReader(plotter, buffers=writer.depth + 2)
+        # pyvista's render() does nothing until a first show() or screenshot()
+        plotter.screenshot(return_img=False)
         for i, t in enumerate(times):
             if clip is not None:
                 clip.sample(t, out=pose)
@@ -205,7 +210,7 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
             plotter.camera.position = base_focal + shift + rel
             plotter.reset_camera_clipping_range()
             plotter.render()
-            writer.append(plotter.screenshot(return_img=True))
+            writer.append(reader.read())
             if progress is not None and progress(i + 1, len(times)) is False:
                 raise RecordingCancelled(f"recording cancelled after {i + 1} frames")
         writer.commit()
@@ -215,6 +220,100 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         if writer is not None:
             writer.abort()
         plotter.close()
+
+
+class FrameReader:
+    """Reads the rendered frame's RGB pixels into a ring of preallocated buffers (no
+    per-frame filter or array as ``plotter.screenshot`` makes).
+
+    Parameters
+    ----------
+    plotter : pyvista.Plotter
+        Rendered off-screen, multi-sampled or not (the front buffer holds the resolved frame).
+    buffers : int
+        How many frames may be in use at once (queued for the encoder): a buffer is written
+        again only after ``buffers - 1`` further reads.
+    """
+
+    def __init__(self, plotter, buffers=4):
+        import vtk
+
+        self.ren_win = plotter.render_window
+        self.width, self.height = (int(s) for s in self.ren_win.GetSize())
+        self._vtk = [vtk.vtkUnsignedCharArray() for _ in range(max(1, buffers))]
+        for arr in self._vtk:
+            arr.SetNumberOfComponents(3)
+            arr.SetNumberOfTuples(self.width * self.height)
+        self._next = 0
+
+    def read(self):
+        """The last rendered frame.
+
+        Returns
+        -------
+        image : (H, W, 3) uint8
+            Top row first; a view of a buffer that a later read reuses.
+        """
+        from vtk.util.numpy_support import vtk_to_numpy
+
+        arr = self._vtk[self._next]
+        self._next = (self._next + 1) % len(self._vtk)
+        # front buffer: what screenshot() reads; VTK's rows run bottom-up
+        self.ren_win.GetPixelData(0, 0, self.width - 1, self.height - 1, 1, arr, 0)
+        return vtk_to_numpy(arr).reshape(self.height, self.width, 3)[::-1]
+
+
+class _ThreadedWriter:
+    """A :class:`_Writer` fed from a thread through a bounded queue, so that writing a frame
+    into ffmpeg's pipe (and waiting for it when the encoder lags) overlaps the rendering of
+    the next one. An error in the thread is raised, once, by the next :meth:`append` or by
+    :meth:`commit`."""
+
+    _END = object()
+
+    def __init__(self, writer, depth=2):
+        self.writer = writer
+        self.depth = depth
+        self.error = None
+        self._queue = queue.Queue(maxsize=depth)
+        self._thread = threading.Thread(target=self._run, name="rigedit-encoder", daemon=True)
+        self._thread.start()
+
+    def _run(self):
+        while True:
+            frame = self._queue.get()
+            if frame is self._END:
+                return
+            if self.error is None:
+                try:
+                    self.writer.append(frame)
+                except BaseException as exc:   # kept for the recording thread to raise
+                    self.error = exc
+
+    def _raise(self):
+        if self.error is not None:
+            raise self.error
+
+    def append(self, frame):
+        """Queue ``frame`` (H, W, 3) uint8; blocks while ``depth`` frames wait."""
+        self._raise()
+        self._queue.put(frame)
+
+    def _finish(self):
+        if self._thread.is_alive():
+            self._queue.put(self._END)
+            self._thread.join()
+
+    def commit(self):
+        self._finish()
+        self._raise()
+        self.writer.commit()
+
+    def abort(self):
+        # the thread still drains what is queued (frames are dropped once an error is kept)
+        self.error = self.error or RecordingCancelled("aborted")
+        self._finish()
+        self.writer.abort()
 
 
 def _use_egl_without_display():
