@@ -30,12 +30,15 @@ from rigedit.errors import RigFileError
 from rigedit.io import load_clip, load_mesh, load_rig_folder, load_skeleton, load_weights
 
 FUZZ_EXAMPLES = int(os.environ.get("RIGEDIT_FUZZ_EXAMPLES", "60"))
-#: Per load: the wall-clock bound (hypothesis' deadline) and the peak of memory traced by
-#: Python and numpy during the load.
-DEADLINE_MS = 2000
+#: Per load: at most 2 s of CPU time (a loop that never ends burns CPU; CPU time does not
+#: count the waits of a machine shared with other jobs, which made wall-clock deadlines
+#: flaky here: 3 s for loads that take 50 ms alone), 30 s of wall-clock time (a blocking
+#: wait burns none), and the peak of memory traced by Python and numpy during the load.
+MAX_CPU_SECONDS = 2.0
+MAX_WALL_SECONDS = 30.0
 MAX_PEAK_BYTES = 256 * 2**20
 
-FUZZ = settings(max_examples=FUZZ_EXAMPLES, deadline=DEADLINE_MS, derandomize=True,
+FUZZ = settings(max_examples=FUZZ_EXAMPLES, deadline=None, derandomize=True,
                 database=None, suppress_health_check=[HealthCheck.too_slow,
                                                       HealthCheck.data_too_large])
 
@@ -227,7 +230,7 @@ def _load_checked(path, load):
     """Run ``load(path)``: it returns, or raises a RigFileError naming ``path``; memory
     traced during the load stays under the bound."""
     tracemalloc.start()
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -240,7 +243,8 @@ def _load_checked(path, load):
         peak = tracemalloc.get_traced_memory()[1]
         tracemalloc.stop()
     assert peak < MAX_PEAK_BYTES, f"{peak / 2**20:.0f} MB traced while loading"
-    assert time.perf_counter() - t0 < DEADLINE_MS / 1000
+    cpu, wall = time.process_time() - cpu0, time.perf_counter() - t0
+    assert cpu < MAX_CPU_SECONDS and wall < MAX_WALL_SECONDS, f"{cpu:.1f} s CPU, {wall:.1f} s"
     return result
 
 
