@@ -74,6 +74,11 @@ class RigScene:
     rig : Rig
     show_skeleton : bool
     show_floor : bool
+    skinning : {"lbs", "dqs"}
+    skinned_normals : bool
+        LBS only, for a fixed skinning method (the recorder): normals blended with the
+        vertices in one pass (``SkinBinding.skin_with_normals``) instead of recomputed by VTK
+        each frame; exact in the rest pose, within shading noise when posed.
 
     Attributes
     ----------
@@ -83,11 +88,15 @@ class RigScene:
         One line per bone; points are the joint positions.
     """
 
-    def __init__(self, plotter, rig, show_skeleton=True, show_floor=True, skinning="lbs"):
+    def __init__(self, plotter, rig, show_skeleton=True, show_floor=True, skinning="lbs",
+                 skinned_normals=False):
         self.plotter = plotter
         self.rig = rig
         #: The skinning method of every update: "lbs" or "dqs" (SkinBinding.skin)
         self.skinning = skinning
+        #: Normals blended in the LBS pass from rest normals (VTK's, computed once) instead
+        #: of vtkPolyDataNormals on every changed frame; LBS only
+        self.skinned_normals = bool(skinned_normals) and skinning == "lbs"
         self.up = up_vector(rig.up)
         self.front = front_vector(rig.up)
         #: False for a rig with no mesh (a BVH skeleton): no mesh actor, the skeleton drawn
@@ -105,8 +114,11 @@ class RigScene:
             self._normals.ConsistencyOff()
             self._normals.AutoOrientNormalsOff()
             self._normals.ComputeCellNormalsOff()
+            shown = self._normals
+            if self.skinned_normals:
+                shown = self._bind_skinned_normals()
             look = self._surface_look()
-            self.mesh_actor = plotter.add_mesh(self._normals, smooth_shading=True,
+            self.mesh_actor = plotter.add_mesh(shown, smooth_shading=True,
                                                specular=0.25, specular_power=20,
                                                name="rig-mesh", **look)
             self._texture = look.get("texture")
@@ -135,6 +147,28 @@ class RigScene:
         self.view("front")
 
     # ------------------------------------------------------------------ actors
+    def _bind_skinned_normals(self):
+        """Give the binding rest normals from the same filter (run once on the bind-space
+        vertices) and the mesh a "Normals" array that each update fills: in the rest pose the
+        shading is the filter's exactly; posed, each normal turns with its vertex's blend.
+
+        Returns
+        -------
+        mesh : pyvista.PolyData
+            ``self.mesh``, drawn directly (no filter in its pipeline).
+        """
+        binding = self.rig.binding
+        rest = pv.PolyData(np.asarray(binding.rest_vertices, dtype=np.float32),
+                           self.mesh.GetPolys())
+        self._normals.SetInputData(rest)
+        self._normals.Update()
+        binding.bind_normals(pv.wrap(self._normals.GetOutput()).point_data["Normals"])
+        self._normals.SetInputData(self.mesh)
+        self.mesh.point_data.set_array(np.zeros((self.mesh.n_points, 3), np.float32),
+                                       "Normals")
+        self.mesh.point_data.active_normals_name = "Normals"
+        return self.mesh
+
     def _surface_look(self):
         """``add_mesh`` colour/texture arguments from the rig's surface: its materials as one
         texture (each part in its own material's texture or base colour, see
@@ -300,7 +334,13 @@ class RigScene:
             self._update_bare_skeleton(model)
         elif skin:
             palette = skinning_matrices(self.rig.skeleton, model)
-            self.mesh.points[:] = self.rig.binding.skin(palette, method=self.skinning)
+            if self.skinned_normals:
+                points, normals = self.rig.binding.skin_with_normals(palette)
+                self.mesh.point_data["Normals"][:] = normals
+                self.mesh.GetPointData().GetNormals().Modified()
+                self.mesh.points[:] = points
+            else:
+                self.mesh.points[:] = self.rig.binding.skin(palette, method=self.skinning)
             self.mesh.GetPoints().Modified()
             self.mesh.Modified()
         self.joint_positions[:] = model[:, :3, 3]
