@@ -101,7 +101,7 @@ def test_an_encoder_error_in_the_writer_thread_is_raised_once_and_leaves_no_temp
         record_clip(rig, rig.clips["bend"], path, fps=10, duration=2.0, size=SIZE,
                     progress=lambda d, total: done.append(d))
     assert thread_errors == []          # one error, raised in the caller, none in the thread
-    assert written == [(SIZE[1], SIZE[0], 3)] * 3
+    assert [shape[:2] for shape in written] == [(SIZE[1], SIZE[0])] * 3
     assert len(done) < 20               # stopped at the next frame handed over, not the end
     assert path.read_bytes() == b"old video"
     assert [p.name for p in tmp_path.iterdir()] == ["out.mp4"]
@@ -135,13 +135,15 @@ def test_frame_reader_reads_what_screenshot_reads(rig, backdrop):
         assert not backdrop or not plotter.renderer.GetGradientBackground()
         plotter.render()
         first = reader.image(reader.read())
-        assert first.shape == (SIZE[1], SIZE[0], 3)
+        assert first.shape == (SIZE[1], SIZE[0], 4 if backdrop else 3)
+        assert not backdrop or (first[..., 3] == 255).all()
+        first = first[..., :3]
         np.testing.assert_array_equal(first, shot)   # same rows, top row first
         assert shot[0].mean() != shot[-1].mean()     # the gradient: a flip would show
         kept = first.copy()
         plotter.camera.Zoom(2.0)                     # the cylinder fills more of the frame
         plotter.render()
-        second = reader.image(reader.read())
+        second = reader.image(reader.read())[..., :3]
         np.testing.assert_array_equal(first, kept)   # the ring did not reuse the first buffer
         assert np.abs(second.astype(int) - kept).mean() > 0.5
         np.testing.assert_array_equal(second, zoomed)  # as drawn with the gradient

@@ -284,10 +284,11 @@ class FrameReader:
         self.ren_win.AlphaBitPlanesOn()
         self._channels = 4
         self._make_buffers(len(self._vtk))
-        self.backdrop = backdrop[::-1].copy()   # rows bottom-up, as VTK reads them
+        # rows bottom-up, as VTK reads them; RGBA, opaque, to composite whole pixels
+        self.backdrop = np.dstack([backdrop[::-1], np.full(backdrop.shape[:2], 255, np.uint8)])
         renderer.ResetCameraClippingRange()
         plotter.render()
-        if not np.array_equal(self.image(self.read()), reference):
+        if not np.array_equal(self.image(self.read())[..., :3], reference):
             # no alpha channel, or something drawn translucent: keep drawing the gradient
             renderer.SetGradientBackground(gradient)
             renderer.SetBackgroundAlpha(alpha)
@@ -309,14 +310,23 @@ class FrameReader:
         return vtk_to_numpy(arr).reshape(self.height, self.width, self._channels)
 
     def image(self, raw):
-        """(H, W, 3) uint8 picture of a :meth:`read` frame, top row first (VTK's rows run
-        bottom-up); a view of ``raw`` without a backdrop, a new array with one."""
+        """The picture of a :meth:`read` frame, top row first (VTK's rows run bottom-up).
+
+        Returns
+        -------
+        image : (H, W, 3) uint8, or (H, W, 4) uint8 RGBA with opaque alpha with a backdrop
+            A view of ``raw`` without a backdrop, a new array with one. RGBA goes to ffmpeg
+            as it is (it converts to YUV in its own process): dropping the alpha here was a
+            strided copy as costly as the compositing.
+        """
         if self.backdrop is None:
             return raw[::-1]
-        out = np.empty((self.height, self.width, 3), np.uint8)
-        flipped = out[::-1]   # written bottom-up, so out itself is top-down and contiguous
-        np.copyto(flipped, raw[..., :3])
-        np.copyto(flipped, self.backdrop, where=raw[..., 3:] == 0)
+        out = np.empty((self.height, self.width, 4), np.uint8)
+        # whole pixels as 32-bit words: one masked copy instead of one per channel; written
+        # bottom-up so that ``out`` itself is top-down and contiguous
+        flipped = out.view(np.uint32)[::-1, :, 0]
+        np.copyto(flipped, raw.view(np.uint32)[..., 0])
+        np.copyto(flipped, self.backdrop.view(np.uint32)[..., 0], where=raw[..., 3] == 0)
         return out
 
 
