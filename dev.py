@@ -94,6 +94,26 @@ def ensure_venv(extra):
     stamp.touch()
 
 
+def gltf_validator_env():
+    """Environment that lets the tests run the Khronos glTF Validator (npm package
+    ``gltf-validator``) on every export, installed once into ``.venv/node`` where Node.js and
+    npm exist; an empty dict (those tests skip, the structural checks still run) otherwise."""
+    node_dir = VENV / "node"
+    module = node_dir / "node_modules" / "gltf-validator"
+    if not module.is_dir() and shutil.which("npm") and shutil.which("node"):
+        say("installing the Khronos glTF Validator (npm gltf-validator) into .venv/node")
+        try:
+            subprocess.run(["npm", "install", "--silent", "--no-audit", "--no-fund", "--prefix",
+                            str(node_dir), "gltf-validator"], check=False, timeout=300,
+                           stdout=subprocess.DEVNULL)
+        except (OSError, subprocess.TimeoutExpired) as exc:
+            say(f"glTF Validator not installed ({exc}); its tests will skip")
+    if not module.is_dir() or not shutil.which("node"):
+        return {}
+    return {"RIGEDIT_GLTF_VALIDATOR": str(ROOT / "tests" / "gltf_validator.js"),
+            "NODE_PATH": str(node_dir / "node_modules")}
+
+
 def main(argv):
     if not argv or argv[0] not in ("run", "test", "setup"):
         sys.exit("usage: python3 dev.py run [RIG] | test [PYTEST ARGS] | setup")
@@ -104,6 +124,7 @@ def main(argv):
     if cmd == "setup":
         return 0
     if cmd == "test":
+        env.update(gltf_validator_env())
         say("running the tests")
         return subprocess.run([str(PY), "-m", "pytest", *rest], cwd=ROOT, env=env).returncode
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
