@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import tempfile
 import time
 from pathlib import Path
@@ -107,17 +108,24 @@ def frame_like_the_recorder(plotter, rig, clip, frames, fps):
     RigScene.view(view, "front", points=swept_points(rig, clip, times))
 
 
+encoder_cpu = []   # ffmpeg's CPU seconds per frame (children of this process), per call
+
+
 def recorded(rig, clip, path, frames, fps, size, module=None, **options):
     if module is None:
         from rigedit.render.recorder import record_clip
     else:
         record_clip = module.record_clip
     stamps = []
+    f0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0, c0 = time.perf_counter(), time.process_time()
     n = record_clip(rig, clip, path, fps=fps, duration=frames / fps, size=size,
                     progress=lambda done, total: stamps.append(
                         (time.perf_counter(), time.process_time())), **options)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    f1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if Path(path).suffix == ".mp4":   # a GIF is written by this process
+        encoder_cpu.append((f1.ru_utime + f1.ru_stime - f0.ru_utime - f0.ru_stime) / n)
     (w1, c1), (w2, c2) = stamps[0], stamps[-1]
     loop = ((n - 1) / (w2 - w1), (c2 - c1) / (n - 1))
     return (n / wall, cpu / n), loop
@@ -182,6 +190,8 @@ def main(argv=None):
         print(f"  {label:40s} {best:7.1f} {spread:7.1f} {cpu * 1e3:8.1f} ms   frames/s")
     b = summary(runs["bare plotter (skin, draw, read back)"])
     r = summary(runs[configs[0][0]])
+    print(f"  ffmpeg's own CPU time per frame (its process): "
+          f"{min(encoder_cpu) * 1e3:.1f}-{max(encoder_cpu) * 1e3:.1f} ms")
     print(f"  achieved / bare: {r[0] / b[0]:.2f} (best rates); CPU per frame "
           f"{r[2] / b[2]:.2f}x the bare plotter's (load average now "
           f"{os.getloadavg()[0]:.1f})")
