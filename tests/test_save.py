@@ -103,6 +103,22 @@ def test_clip_keeps_its_file_name_and_a_foreign_clip_file_is_left_alone(tmp_path
     assert sorted(load(folder).clips) == ["bend", "extra"]
 
 
+def test_a_fifo_named_like_a_clip_file_does_not_block_a_save(tmp_path):
+    import threading
+
+    folder = tmp_path / "r"
+    rig = cylinder_rig()
+    save_rig_folder(folder, rig)
+    os.mkfifo(folder / "animations" / "pipe.json")
+    done = []
+    worker = threading.Thread(target=lambda: done.append(save_rig_folder(folder, rig)),
+                              daemon=True)   # a blocked open would hang the test run otherwise
+    worker.start()
+    worker.join(30)
+    assert done, "the save blocked on a FIFO in animations/"
+    assert (folder / "animations" / "pipe.json").is_fifo()   # not rigedit's: left alone
+
+
 def test_an_unrecorded_file_of_a_saved_clip_is_its_file_a_second_one_stops_the_save(tmp_path):
     folder = tmp_path / "r"
     rig = cylinder_rig()

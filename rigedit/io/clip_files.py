@@ -20,6 +20,7 @@ anything is written. The rig's own files (``rig.json``, the mesh, ``skeleton.jso
 from __future__ import annotations
 
 import json
+import stat
 import weakref
 from pathlib import Path, PurePosixPath
 
@@ -74,10 +75,12 @@ def _previous_manifest(folder):
 def _declared_name(path):
     """The clip name a JSON file declares, or None (unreadable, not a clip)."""
     try:
-        if path.stat().st_size > 64 * 2**20:
+        # Look before opening: a FIFO or device named like a clip would block the save.
+        info = path.stat()
+        if not stat.S_ISREG(info.st_mode) or info.st_size > 64 * 2**20:
             return None
         data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return None
     if isinstance(data, dict) and ("tracks" in data or "keyframes" in data):
         return str(data.get("name") or path.stem)
