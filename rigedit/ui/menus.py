@@ -35,6 +35,12 @@ class MenusMixin:
         m.addAction(self._action("&Open rig folder...", f.open_folder, "Ctrl+O"))
         m.addAction(self._action("Open mesh + skeleton...", f.open_mesh_skeleton))
         m.addAction(self._action("Open glTF or BVH file...", f.open_file, "Ctrl+Shift+O"))
+        from .import_motion import ImportMotion
+
+        self.motion_import = ImportMotion(self)
+        m.addAction(self._action("Import motion onto this character...", self.motion_import.run,
+                                 tip="Retarget a BVH, glTF or rig folder's clip onto this "
+                                     "character as a new clip"))
         m.addSeparator()
         m.addAction(self._action("&Save rig", f.save, "Ctrl+S"))
         m.addAction(self._action("Save rig &as...", f.save_as, "Ctrl+Shift+S"))

@@ -540,16 +540,23 @@ class TimelineDock(QtWidgets.QDockWidget):
     def new_clip(self, name=None, duration=2.0):
         """Add an empty clip and make it current. Returns its name, or None (and an error
         in the status bar) for an invalid name."""
-        name = self._valid_name(self._unique(name or "clip"))
+        clip = Clip("clip", self.document.skeleton, {}, duration=duration)
+        return self.add_clip(clip, name or "clip", lambda n: f"New clip {n}")
+
+    def add_clip(self, clip, base, label):
+        """Add ``clip`` (on the document's skeleton) under ``base`` made unique, as one undo
+        step, and make it current. ``label`` is the undo step's text, or a function of the
+        name. Returns the name, or None (and an error in the status bar) for an invalid name."""
+        name = self._valid_name(self._unique(base))
         if name is None:
             return None
-        clip = Clip(name, self.document.skeleton, {}, duration=duration)
+        clip.name = name
 
         def change():
             self.document.clips[name] = clip
             return name
 
-        self._edit_clips(f"New clip {name}", change)
+        self._edit_clips(label(name) if callable(label) else label, change)
         return name
 
     def rename_clip(self, new=None):
@@ -580,17 +587,7 @@ class TimelineDock(QtWidgets.QDockWidget):
         clip = self.clip
         if clip is None:
             return None
-        name = self._valid_name(self._unique(f"{clip.name} copy"))
-        if name is None:
-            return None
-        copy = clip.copy(name)
-
-        def change():
-            self.document.clips[name] = copy
-            return name
-
-        self._edit_clips(f"Duplicate clip {clip.name}", change)
-        return name
+        return self.add_clip(clip.copy(), f"{clip.name} copy", f"Duplicate clip {clip.name}")
 
     def delete_clip(self):
         old = self.document.current_clip
