@@ -70,6 +70,7 @@ def test_import_bandai_walk_adds_one_moving_clip_as_one_undo_step(humanoid_windo
     assert set(doc.clips) == set(before[0]) | {name}, w.statusBar().currentMessage()
     assert doc.current_clip == name
     assert len(doc.undo_stack) == steps + 1
+    assert w.info_panel.labels["Clips"].text() == str(len(before[0]) + 1)
     clip = doc.clips[name]
     assert clip.skeleton is doc.skeleton
     source = _load(WALK).clips["take"]
@@ -90,6 +91,7 @@ def test_import_bandai_walk_adds_one_moving_clip_as_one_undo_step(humanoid_windo
     added = clip
     doc.undo()
     assert _state(doc) == before
+    assert w.info_panel.labels["Clips"].text() == str(len(before[0]))
     assert len(doc.undo_stack) == steps
     doc.redo()
     assert doc.current_clip == name and doc.clips[name] is added

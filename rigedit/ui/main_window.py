@@ -305,6 +305,8 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
         elif event == "undo":
             self._update_undo_actions()
             self._update_title()
+        elif event == "clip":   # clips added, removed or renamed: the Info count follows
+            self.info_panel.labels["Clips"].setText(str(len(d.clips)))
 
     def _update_undo_actions(self):
         s = self.document.undo_stack
