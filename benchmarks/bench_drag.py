@@ -31,19 +31,24 @@ def _limb_joint(sk):
     return len(sk) - 1
 
 
+def drag_targets(rig, steps):
+    """The dragged limb joint, the rest pose and (steps, 3) targets on a loop around it."""
+    j = _limb_joint(rig.skeleton)
+    start = rig.rest_pose()
+    head = rig.joint_matrices(start)[j, :3, 3]
+    a = np.linspace(0, 6, steps)
+    targets = head + 0.15 * rig.height() * np.stack([np.sin(a), np.cos(a) - 1,
+                                                     np.zeros(steps)], axis=1)
+    return j, start, targets
+
+
 def model_step(rig, steps=300):
     from rigedit.model.ik import drag_joint
 
     sk = rig.skeleton
-    j = _limb_joint(sk)
-    start = rig.rest_pose()
+    j, start, targets = drag_targets(rig, steps)
     snap = start.as_array()
     work = start.copy()
-    head = rig.joint_matrices(start)[j, :3, 3]
-    h = rig.height()
-    targets = head + 0.15 * h * np.stack([np.sin(np.linspace(0, 6, steps)),
-                                          np.cos(np.linspace(0, 6, steps)) - 1,
-                                          np.zeros(steps)], axis=1)
     times = []
     for t in targets:
         t0 = time.perf_counter()
