@@ -186,24 +186,33 @@ class Skeleton:
         child = np.flatnonzero(self.parents >= 0)
         return np.stack([self.parents[child], child], axis=1)
 
-    def bone_segments(self):
+    def bone_segments(self, deform=None, tails=None):
         """Model-space bone segments at bind time and the joint that each one moves with.
 
         A joint's bone runs from its head to its tail where the format gave one, otherwise
         one segment from its head to each child's head; a leaf with no tail is a point
         (zero-length segment). Joints with ``deform`` false own no segment.
 
+        Parameters
+        ----------
+        deform : (J,) bool, optional
+            Joints that own segments (default: the skeleton's ``deform`` flags).
+        tails : (J, 3) float64, optional
+            Model-space tails, NaN rows where a joint has none (default: the skeleton's).
+
         Returns
         -------
         starts, ends : (S, 3) float64
         owners : (S,) int
         """
+        deform = self.deform if deform is None else deform
+        tails = self.tails if tails is None else tails
         heads = self.bind_matrices[:, :3, 3]
         starts, ends, owners = [], [], []
-        for j in np.flatnonzero(self.deform):
+        for j in np.flatnonzero(deform):
             kids = self.children(j)
-            if np.all(np.isfinite(self.tails[j])):
-                targets = self.tails[j][None]
+            if np.all(np.isfinite(tails[j])):
+                targets = tails[j][None]
             elif len(kids):
                 targets = heads[kids]
             else:

@@ -80,7 +80,8 @@ def _inside_fraction(points, vertices, normals):
 
 
 def bone_segments_with_tails(skeleton, deform, tails):
-    """Segments of the deforming joints, with given tails for leaves.
+    """Segments of the deforming joints, with given tails for leaves
+    (:meth:`Skeleton.bone_segments` with ``deform`` and ``tails`` given).
 
     Parameters
     ----------
@@ -95,20 +96,7 @@ def bone_segments_with_tails(skeleton, deform, tails):
     starts, ends : (S, 3) float64
     owners : (S,) int64
     """
-    heads = skeleton.bind_matrices[:, :3, 3]
-    starts, ends, owners = [], [], []
-    for j in np.flatnonzero(deform):
-        kids = skeleton.children(j)
-        if np.all(np.isfinite(tails[j])):
-            targets = tails[j][None]
-        elif len(kids):
-            targets = heads[kids]
-        else:
-            targets = heads[j][None]
-        starts.append(np.repeat(heads[j][None], len(targets), axis=0))
-        ends.append(targets)
-        owners.append(np.full(len(targets), j))
-    return np.concatenate(starts), np.concatenate(ends), np.concatenate(owners)
+    return skeleton.bone_segments(deform=deform, tails=tails)
 
 
 def infer_leaf_tails(skeleton, deform, vertices, nearest_owner, rays=None):
