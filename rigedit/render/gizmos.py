@@ -43,6 +43,15 @@ def world_to_display(renderer, world):
     return np.array(renderer.GetDisplayPoint())
 
 
+def display_to_world(renderer, x, y, z):
+    """(3,) world point at display pixel (x, y) and depth ``z`` (0 near plane, 1 far) in
+    ``renderer``: the inverse of :func:`world_to_display`."""
+    renderer.SetDisplayPoint(float(x), float(y), float(z))
+    renderer.DisplayToWorld()
+    w = np.array(renderer.GetWorldPoint())
+    return w[:3] / w[3]
+
+
 def gizmo_radius(rig):
     """Joint sphere radius from the character's size and its bone lengths (model units)."""
     lo, hi = rig.bounds()
@@ -337,15 +346,9 @@ class AxisHandles:
     def ray(self, x, y):
         """The mouse ray through display pixel (x, y): origin on the near plane and unit
         direction, in world coordinates (perspective or parallel camera alike)."""
-        ren = self.renderer
-        ends = []
-        for z in (0.0, 1.0):
-            ren.SetDisplayPoint(float(x), float(y), z)
-            ren.DisplayToWorld()
-            w = np.array(ren.GetWorldPoint())
-            ends.append(w[:3] / w[3])
-        d = ends[1] - ends[0]
-        return ends[0], d / np.linalg.norm(d)
+        near = display_to_world(self.renderer, x, y, 0.0)
+        d = display_to_world(self.renderer, x, y, 1.0) - near
+        return near, d / np.linalg.norm(d)
 
     # ------------------------------------------------------------------ picking
     def pick(self, x, y):

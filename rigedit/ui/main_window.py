@@ -350,6 +350,11 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
         self.scene.set_floor_visible(on)
         self.request_render()
 
+    @property
+    def weights_view(self):
+        """Whether the weight paint view is on (set with :meth:`set_weights_view`)."""
+        return self._weights_view
+
     def set_weights_view(self, on):
         """Weight paint view: colour the mesh by the selected joint's influence."""
         self.weights_action.setChecked(bool(on))

@@ -22,6 +22,7 @@ from PyQt5 import QtWidgets
 
 from ..model.weight_paint import (brush_vertices, joint_column, mirror_vertices, paint,
                                   paint_mirrored, vertex_adjacency)
+from ..render.gizmos import display_to_world, world_to_display
 from .brush_panel import BrushPanel
 
 __all__ = ["BrushPanel", "WeightBrush", "install_weight_brush"]
@@ -115,7 +116,7 @@ class WeightBrush:
         action = getattr(self, "action", None)
         if action is not None and action.isChecked() != on:
             action.setChecked(on)  # toggled() calls back here with the same value: no loop
-        if on and not self.w._weights_view:
+        if on and not self.w.weights_view:
             self.w.set_weights_view(True)
         if not on:
             self.cancel()
@@ -153,7 +154,7 @@ class WeightBrush:
     _EVENTS = ("LeftButtonPressEvent", "MouseMoveEvent", "LeftButtonReleaseEvent")
 
     def _active(self):
-        return self.enabled and self.w._weights_view and self.w.scene.has_mesh
+        return self.enabled and self.w.weights_view and self.w.scene.has_mesh
 
     def _press(self, iren):
         """Returns True when the press is the brush's (a stroke or a vertex query)."""
@@ -167,7 +168,7 @@ class WeightBrush:
             self.show_vertex(self.nearest_vertex(hit))
             return True
         if not self._active():
-            if self.w._weights_view:  # a plain click (no drag) in the view shows a vertex
+            if self.w.weights_view:  # a plain click (no drag) in the view shows a vertex
                 hit = self.pick(x, y)
                 self._click = None if hit is None else (x, y, self.nearest_vertex(hit))
             return False
@@ -236,12 +237,7 @@ class WeightBrush:
         locator = self._current_locator()
         if locator is None:
             return None
-        ends = []
-        for z in (0.0, 1.0):
-            ren.SetDisplayPoint(float(x), float(y), z)
-            ren.DisplayToWorld()
-            w = np.array(ren.GetWorldPoint())
-            ends.append(w[:3] / w[3])
+        ends = [display_to_world(ren, x, y, z) for z in (0.0, 1.0)]
         t, sub, cell = vtk.reference(0.0), vtk.reference(0), vtk.reference(0)
         hit, pcoords = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
         if not locator.IntersectWithLine(ends[0], ends[1], 0.0, t, hit, pcoords, sub, cell):
@@ -276,13 +272,8 @@ class WeightBrush:
     def world_radius(self, point, pixels):
         """Scene units that ``pixels`` span on screen at the depth of ``point``."""
         ren = self.w.plotter.renderer
-        ren.SetWorldPoint(*point, 1.0)
-        ren.WorldToDisplay()
-        dx, dy, dz = ren.GetDisplayPoint()
-        ren.SetDisplayPoint(dx + float(pixels), dy, dz)
-        ren.DisplayToWorld()
-        q = np.array(ren.GetWorldPoint())
-        return float(np.linalg.norm(q[:3] / q[3] - point))
+        dx, dy, dz = world_to_display(ren, point)
+        return float(np.linalg.norm(display_to_world(ren, dx + float(pixels), dy, dz) - point))
 
     def nearest_vertex(self, point):
         pts = np.asarray(self.w.scene.mesh.points)
@@ -337,7 +328,7 @@ class WeightBrush:
         else:
             s["indices"], s["weights"] = paint(*args, **options)
         s["dabs"] += 1
-        if self.w._weights_view:
+        if self.w.weights_view:
             self.w.scene.show_weights(joint_column(s["indices"], s["weights"], j))
         self.w.request_render()
 
@@ -361,7 +352,7 @@ class WeightBrush:
         """Drop a stroke under way (the shown colours go back to the document's)."""
         if self.stroke is not None:
             self.stroke = None
-            if self.w._weights_view:
+            if self.w.weights_view:
                 self.w._show_weights()
 
     # ------------------------------------------------------------------ vertex query
