@@ -99,7 +99,6 @@ class Rig:
                                            sk.bind_matrices, rtol=0, atol=1e-9):
             points = self.skin(self.rest_pose())
         if len(points) == 0:
-            sk = self.skeleton
             tails = sk.tails[np.all(np.isfinite(sk.tails), axis=1)]
             points = np.vstack([sk.bind_matrices[:, :3, 3], tails])
         return np.stack([points.min(axis=0), points.max(axis=0)])

@@ -95,7 +95,7 @@ def _read_obj(path):
     return vertices, faces
 
 
-def _third_party(path, read):
+def third_party_read(path, read):
     """Call a third-party reader so that nothing it does reaches the user: its prints go to a
     buffer, a ``sys.exit`` or any exception becomes a ``RigFileError`` naming the file."""
     out = io.StringIO()
@@ -136,7 +136,7 @@ def _read_meshio(path):
     if path.suffix.lower() == ".ply":
         _check_ply_header(path, path.stat().st_size)
 
-    m = _third_party(path, lambda: meshio.read(path))
+    m = third_party_read(path, lambda: meshio.read(path))
     polys = []
     for block in m.cells:
         if block.type in ("triangle", "quad", "polygon"):

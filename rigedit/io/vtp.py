@@ -14,7 +14,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from ..errors import RigFileError
-from .mesh import _third_party, triangulate
+from .mesh import third_party_read, triangulate
 from .paths import read_bytes
 
 __all__ = ["read_vtp", "check_vtp"]
@@ -111,7 +111,7 @@ def read_vtp(path):
     shown = vtkObject.GetGlobalWarningDisplay()
     vtkObject.GlobalWarningDisplayOff()
     try:
-        code, poly = _third_party(path, read)
+        code, poly = third_party_read(path, read)
     finally:
         vtkObject.SetGlobalWarningDisplay(shown)
     if poly is None or poly.GetNumberOfPoints() == 0 or poly.GetPolys() is None:
