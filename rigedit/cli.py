@@ -123,11 +123,7 @@ def cmd_render(args):
     from .cli_output import check_interrupted, deferred
     from .render.recorder import record_clip
 
-    size = _parse_size(args.size)
-    if args.fps <= 0:
-        raise UsageError(f"--fps: expected a positive number, got {args.fps}")
-    if args.duration is not None and args.duration <= 0:
-        raise UsageError(f"--duration: expected a positive number, got {args.duration}")
+    size = _parse_size(args.size)  # fps, duration and size were checked by check_options
     rig = _load(args.rig, scale=args.scale)
     if args.clip not in rig.clips:
         raise UsageError(f"{rig.path}: unknown clip {args.clip!r}; clips: "
