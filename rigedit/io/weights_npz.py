@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import RigFileError
 from .atomic import atomic_write
+from .jsonfile import MAX_NAME_CHARS
 from .paths import os_problem, regular_file
 
 __all__ = ["load_weights", "save_weights", "weights_vertex_count", "MAX_INFLUENCES"]
@@ -21,7 +22,6 @@ __all__ = ["load_weights", "save_weights", "weights_vertex_count", "MAX_INFLUENC
 #: Most influences per vertex a weights file may hold (the binding keeps up to 8).
 MAX_INFLUENCES = 64
 MAX_JOINTS = 2**16
-MAX_NAME_CHARS = 256
 #: What a broken archive or member may raise while being read (zlib.error: corrupt deflate
 #: data; RuntimeError: an encrypted member).
 _ZIP_ERRORS = (ValueError, OSError, EOFError, RuntimeError, NotImplementedError,
