@@ -88,6 +88,9 @@ class Calibration:
         ``"rest"`` or ``"frame 0 of <clip>"``.
     up, left : (3,) float64
         Unit body axes: hips to chest, and from the right limbs to the left ones.
+    contacts : list of 4 int
+        Left and right ankle, then left and right toe joints (the ankle where a toe is
+        missing): the foot contact points.
     floor : float
         Lowest foot point (feet, toes and their tails) in the pose, model y.
     joint_floor : float
@@ -108,6 +111,9 @@ class Calibration:
         left = (p[s["thigh_L"]] - p[s["thigh_R"]]) + (p[s["upper_arm_L"]] - p[s["upper_arm_R"]])
         self.left = unit(left - self.up * np.dot(left, self.up))
         self.feet = [s[k] for k in ("foot_L", "foot_R", "toe_L", "toe_R") if k in s]
+        # the contact points: left/right ankle, then left/right toe (the ankle without a toe)
+        self.contacts = [s["foot_L"], s["foot_R"], s.get("toe_L", s["foot_L"]),
+                         s.get("toe_R", s["foot_R"])]
         self.floor = float(self.foot_points(mats[None])[0, :, 1].min())
         self.joint_floor = float(p[self.feet, 1].min())
         # Leg length standing: thigh, shin and the lower ankle's height, so a rest with

@@ -99,13 +99,9 @@ def lowest_foot(result, mats=None):
 def target_foot_points(result, mats=None):
     """(F, 4, 3) target left/right ankle and toe joints (the contact points)."""
     mats = result.mats if mats is None else mats
-    s = result.target_calibration.slots
-    idx = [s["foot_L"], s["foot_R"], s.get("toe_L", s["foot_L"]), s.get("toe_R", s["foot_R"])]
-    return mats[:, idx][..., :3, 3]
+    return mats[:, result.target_calibration.contacts][..., :3, 3]
 
 
 def source_foot_points(result):
     """(F, 4, 3) source left/right ankle and toe joints after the facing turn."""
-    s = result.source_calibration.slots
-    idx = [s["foot_L"], s["foot_R"], s.get("toe_L", s["foot_L"]), s.get("toe_R", s["foot_R"])]
-    return result.source_mats[:, idx][..., :3, 3]
+    return result.source_mats[:, result.source_calibration.contacts][..., :3, 3]

@@ -185,8 +185,7 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
     n_frames, nj = len(times), len(tsk)
     rot = np.empty((n_frames, nj, 3, 3))
     rest_rot = Rotation.from_quat(tsk.rest_rotation).as_matrix()
-    src_feet = [src.slots[k] for k in ("foot_L", "foot_R")] + [
-        src.slots.get(k, src.slots[f]) for k, f in (("toe_L", "foot_L"), ("toe_R", "foot_R"))]
+    src_feet = src.contacts
     s_feet = smats[:, src_feet][..., :3, 3]
     # the motion's own floor: a low percentile of the lowest foot point per frame
     s_floor = float(np.percentile(s_feet[..., 1].min(axis=1), 5)) if n_frames > 1 else src.floor
@@ -245,8 +244,7 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
     hips_t[:, 1] = tgt.joint_floor + (hips_s[:, 1] - s_floor - src.hip_offset) * scale \
         + tgt.hip_offset
     raw = _assemble(tsk, rot, tgt.slots["hips"], hips_t)
-    tgt_feet = [tgt.slots[k] for k in ("foot_L", "foot_R")] + [
-        tgt.slots.get(k, tgt.slots[f]) for k, f in (("toe_L", "foot_L"), ("toe_R", "foot_R"))]
+    tgt_feet = tgt.contacts
     mats = raw
     if clean_feet:
         rot, drop = hold_feet(tsk, tgt, rot, raw, contact, tgt_feet, times, inverse)
