@@ -167,12 +167,20 @@ class DragMixin:
         self._update_undo_actions()
         return job
 
-    def undo(self):
-        """Edit > Undo: cancels a running re-bind when it is the latest edit, else undoes the
-        document's last step."""
+    def _undoable_rebind(self):
+        """The pending re-bind ``(job, top, label)`` when undo would cancel it (it still runs
+        and nothing was done since it started), else None."""
         pending = self._pending_rebind
         if pending is not None and pending[0] is self.job and \
                 self.document.undo_stack.top is pending[1]:
+            return pending
+        return None
+
+    def undo(self):
+        """Edit > Undo: cancels a running re-bind when it is the latest edit, else undoes the
+        document's last step."""
+        pending = self._undoable_rebind()
+        if pending is not None:
             self._pending_rebind = None
             self.job.cancel()
             self.status(f"Undo {pending[2]}: re-bind cancelled")

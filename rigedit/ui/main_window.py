@@ -310,8 +310,8 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
 
     def _update_undo_actions(self):
         s = self.document.undo_stack
-        pending = self._pending_rebind
-        if pending is not None and pending[0] is self.job and s.top is pending[1]:
+        pending = self._undoable_rebind()
+        if pending is not None:
             self.undo_action.setEnabled(True)  # undo cancels the running re-bind
             self.undo_action.setText(f"&Undo {pending[2]}")
         else:
