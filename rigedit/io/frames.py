@@ -151,7 +151,8 @@ def resolve_folder_frames(path, skeleton, meta, vertices, manifest):
     vertices : (V, 3) float
         The mesh as read.
     manifest : dict
-        ``rig.json``: ``"up"`` (the mesh's up axis) and ``"skeleton_up"`` win over a guess.
+        ``rig.json`` as checked by :func:`rigedit.io.rig_folder.read_manifest` (``"up"`` and
+        ``"skeleton_up"`` are ``"y"`` or ``"z"``): they win over a guess.
 
     Returns
     -------
@@ -168,10 +169,6 @@ def resolve_folder_frames(path, skeleton, meta, vertices, manifest):
         clips together, with :func:`change_axes`, once the clips are loaded.
     """
     skeleton_up = manifest.get("skeleton_up", meta["up"])
-    for key, value in (("up", manifest.get("up", "y")), ("skeleton_up", skeleton_up)):
-        if value not in ("y", "z"):
-            raise RigFileError(path / "rig.json", f"expected {key!r} to be 'y' or 'z', got "
-                                                  f"{value!r}")
     if "skeleton_up" in manifest:
         up = manifest.get("up", skeleton_up)
         how = "stated in rig.json"
