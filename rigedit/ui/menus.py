@@ -35,7 +35,13 @@ class MenusMixin:
         m.addAction(self._action("&Open rig folder...", f.open_folder, "Ctrl+O"))
         m.addAction(self._action("Open mesh + skeleton...", f.open_mesh_skeleton))
         m.addAction(self._action("Open glTF or BVH file...", f.open_file, "Ctrl+Shift+O"))
+        from .autorig_dialog import AutorigAction
         from .import_motion import ImportMotion
+
+        self.autorig = AutorigAction(self)
+        m.addAction(self._action("&Auto-rig mesh...", self.autorig.run, "Ctrl+Shift+A",
+                                 tip="Embed a template skeleton (humanoid, quadruped or a "
+                                     "skeleton file) in a mesh and open it in bind mode"))
 
         self.motion_import = ImportMotion(self)
         m.addAction(self._action("Import motion onto this character...", self.motion_import.run,
