@@ -1,0 +1,178 @@
+"""``embed_skeleton``: a template skeleton fitted inside a mesh (Baran and Popovic 2007).
+
+Stages (each timed in ``Embedding.seconds``): the distance field, spheres on the medial
+surface, the graph on their centres, the reduced template, the discrete best-first search,
+the continuous refinement, and the placement of every template joint.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .distance import distance_field
+from .graph import medial_graph
+from .medial import medial_cells, pack_spheres
+from .place import place_joints
+from .refine import refine
+from .search import discrete_embedding
+from .template import reduce_template
+
+__all__ = ["Embedding", "EmbeddingError", "embed_skeleton"]
+
+
+class EmbeddingError(ValueError):
+    """Nothing in the mesh fits the template; the message says what is missing."""
+
+
+@dataclass
+class Embedding:
+    """A template embedded in a mesh.
+
+    Attributes
+    ----------
+    positions : (J, 3) float64
+        Every template joint, template order, in the mesh's frame and units.
+    seconds : dict[str, float]
+        Wall seconds per stage.
+    cost : float
+        Penalty of the discrete embedding (lower is better; ~1 per reduced bone is a fair fit).
+    placed : list[str]
+        Joints placed from the mesh (by the search, and inner joints of embedded chains);
+        the others are carried from the template.
+    scale : float
+        Mesh units per template unit found.
+    spheres : (S, 4) float64
+        The medial spheres (centre, radius), for display and debugging.
+    """
+
+    positions: np.ndarray
+    seconds: dict = field(default_factory=dict)
+    cost: float = 0.0
+    placed: list = field(default_factory=list)
+    scale: float = 1.0
+    spheres: np.ndarray = None
+
+
+def _check_mesh(vertices, faces):
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces)
+    if vertices.ndim != 2 or vertices.shape[1] != 3 or len(vertices) < 4:
+        raise EmbeddingError(f"expected (V, 3) vertices with V >= 4, got shape {vertices.shape}")
+    if not np.all(np.isfinite(vertices)):
+        raise EmbeddingError("expected finite vertex coordinates, got NaN or inf")
+    if faces.ndim != 2 or faces.shape[1] != 3 or len(faces) < 4:
+        raise EmbeddingError(f"expected (F, 3) triangles with F >= 4, got shape {faces.shape}")
+    if not np.issubdtype(faces.dtype, np.integer) or faces.min() < 0 or faces.max() >= len(
+            vertices):
+        raise EmbeddingError(f"expected face indices in [0, {len(vertices) - 1}], got "
+                             f"{faces.min()}..{faces.max()}")
+    if np.ptp(vertices, axis=0).min() <= 0:
+        raise EmbeddingError("expected a mesh with volume, got a flat one")
+    return vertices, faces.astype(np.int64)
+
+
+def _frame(vertices, faces):
+    """Floor, height and middle plane (area-weighted centroid x) of the mesh."""
+    tri = vertices[faces]
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    centre = tri.mean(axis=1)
+    plane = float(np.average(centre[:, 0], weights=area)) if area.sum() > 0 else float(
+        vertices[:, 0].mean())
+    return {"floor": float(vertices[:, 1].min()), "height": float(np.ptp(vertices[:, 1])),
+            "plane_x": plane}
+
+
+def embed_skeleton(vertices, faces, template, progress=None):
+    """Embed a template skeleton in a closed (or nearly closed) triangle mesh.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float64
+        In rigedit's frame (+Y up, facing +Z), any scale and position.
+    faces : (F, 3) int
+    template : rigedit.Skeleton
+        Its rest pose gives the template's joint positions.
+    progress : callable(fraction), optional
+        Called with the fraction done (0..1); may raise to cancel (the exception propagates).
+
+    Returns
+    -------
+    Embedding
+
+    Raises
+    ------
+    EmbeddingError
+        When the mesh is unusable or nothing in it fits the template; the message names the
+        part of the template that found no place.
+    """
+    seconds = {}
+    report = progress or (lambda fraction: None)
+
+    def stage(name, fraction, fn, *args, **kw):
+        t0 = time.perf_counter()
+        out = fn(*args, **kw)
+        seconds[name] = time.perf_counter() - t0
+        report(fraction)
+        return out
+
+    report(0.0)
+    vertices, faces = _check_mesh(vertices, faces)
+    try:
+        reduced = stage("template", 0.02, reduce_template, template)
+    except ValueError as exc:
+        raise EmbeddingError(str(exc)) from None
+    field_ = stage("distance field", 0.3, distance_field, vertices, faces)
+    if not field_.inside.any():
+        raise EmbeddingError("the mesh encloses no volume (is it closed?)")
+    cells = stage("medial surface", 0.4, medial_cells, field_)
+    spheres = stage("spheres", 0.45, pack_spheres, *cells, field_.h)
+    graph = stage("graph", 0.55, medial_graph, field_, *spheres)
+    frame = _frame(vertices, faces)
+    kept = reduced.rest[~reduced.carried]
+    scale = frame["height"] / max(1.15 * np.ptp(kept[:, 1]), 1e-12)
+    if len(graph.points) < len(reduced.joints):
+        raise EmbeddingError(
+            f"no place found for the template's {reduced.label(template, 1)}: the mesh has "
+            f"{len(graph.points)} medial spheres, expected at least {len(reduced.joints)} "
+            "(is it a blob without limbs?)")
+    t0 = time.perf_counter()
+    sub = (lambda f: report(0.55 + 0.25 * f)) if progress else None
+    found = discrete_embedding(graph, reduced, frame, scale, sub)
+    if found.vertex is not None:
+        # Re-scale from the found bones (the first guess comes from the height alone).
+        fitted = _fitted_scale(graph, reduced, found.vertex)
+        if fitted and abs(np.log(fitted / scale)) > 0.05:
+            again = discrete_embedding(graph, reduced, frame, fitted, sub)
+            if again.vertex is not None:
+                found, scale = again, fitted
+    seconds["search"] = time.perf_counter() - t0
+    report(0.8)
+    if found.vertex is None:
+        raise EmbeddingError(f"no place found for the template's "
+                             f"{reduced.label(template, found.failed)}")
+    positions = np.full((len(reduced.joints), 3), np.nan)
+    ok = found.vertex >= 0
+    positions[ok] = graph.points[found.vertex[ok]]
+    paths = [None] + [graph.points[graph.path(found.vertex[reduced.parent[r]], found.vertex[r])]
+                      if ok[r] else None for r in range(1, len(ok))]
+    positions, scale = stage("refinement", 0.95, refine, field_, reduced, positions, scale, frame)
+    out = stage("placement", 1.0, place_joints, reduced, positions, scale, paths)
+    placed_mask = np.zeros(len(out), dtype=bool)
+    for r in np.flatnonzero(ok):
+        placed_mask[reduced.chains[r][1:] if r else [reduced.joints[0]]] = True
+    placed = [template.names[j] for j in np.flatnonzero(placed_mask)]
+    return Embedding(out, seconds, float(found.cost), placed, float(scale),
+                     np.c_[graph.points, graph.radii])
+
+
+def _fitted_scale(graph, reduced, vertex):
+    ratios = []
+    for r in range(1, len(vertex)):
+        a, b = vertex[reduced.parent[r]], vertex[r]
+        if a >= 0 and b >= 0:
+            chord = np.linalg.norm(reduced.rest[reduced.joints[r]]
+                                   - reduced.rest[reduced.joints[reduced.parent[r]]])
+            ratios.append(np.linalg.norm(graph.points[b] - graph.points[a]) / max(chord, 1e-12))
+    return float(np.median(ratios)) if ratios else None

@@ -1,0 +1,97 @@
+"""Penalties of a discrete embedding (Pinocchio section 4), with the weights reasoned out.
+
+Pinocchio learned the weights of its penalties with a support vector machine from a few
+hand-rigged examples. We set them by reasoning instead, so that one unit of cost means
+"clearly wrong", and say why beside each weight. Every term is scale-free: lengths are
+compared as log ratios to the template's (scaled by ``scale``, mesh units per template
+unit), positions as fractions of the mesh's height.
+
+Bone terms depend on the graph vertices of a reduced bone's two ends (an (N, N) matrix per
+bone, so the tree part of the cost can be minimised exactly by dynamic programming); the
+mirror term couples the two sides of the body and is added during the best-first search.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["bone_costs", "joint_costs", "mirror_cost", "W_CARRY", "SEPARATE_RATIO"]
+
+#: Bone length, as (log ratio)^2 of the path length to the template chain's length and of
+#: the chord to the template chord. 3 makes a bone 25% too long or short cost ~0.3 per
+#: measure: proportions vary between characters (short legs, long arms) more than that.
+W_LENGTH = 3.0
+#: Bone direction, times (1 - cos) of the angle to the template chord: 0.6 for 45 degrees
+#: (an A-pose arm against a T-pose template, still acceptable), 2 for a right angle, 4 for
+#: a bone pointing backwards (a leg going up).
+W_DIRECTION = 2.0
+#: Joint height, as the squared difference of the joint's height and the template's, in
+#: quarters of the mesh height: feet low, head high; 0.16 for a tenth of the height off.
+W_HEIGHT = 1.0
+#: Symmetry, as the squared distance between a joint and its mirror partner's reflection in
+#: units of 5% of the template's size (scaled): a limb 5% off its mirror costs 0.5.
+W_MIRROR = 0.5
+#: Price of leaving an optional branch (antlers, a tail) unembedded: higher than a fair fit
+#: (a few tenths) and lower than a forced, contorted one.
+W_CARRY = 2.0
+#: Two limb ends that the template keeps far apart along the tree (the feet: the tree path
+#: through the hips is many times their distance) must be separated in the mesh too: their
+#: graph path must be at least this much longer than their distance. A blob fails here.
+SEPARATE_RATIO = 1.4
+
+
+def bone_costs(points, dist, chord, chain_length, scale):
+    """(N, N) cost of a reduced bone from vertex a (rows) to vertex b (columns).
+
+    Parameters
+    ----------
+    points : (N, 3) float64
+        Graph vertices.
+    dist : (N, N) float64
+        Shortest path lengths.
+    chord : (3,) float64
+        Template vector from the bone's parent joint to its child.
+    chain_length : float
+        Template length of the chain of bones it stands for.
+    scale : float
+        Mesh units per template unit.
+
+    Returns
+    -------
+    (N, N) float64, ``inf`` on the diagonal and between components.
+    """
+    d = points[None, :, :] - points[:, None, :]
+    length = np.linalg.norm(d, axis=2)
+    chord_len = max(float(np.linalg.norm(chord)), 1e-12)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cos = np.einsum("abk,k->ab", d, chord / chord_len) / length
+        cost = W_LENGTH * (np.log(dist / (scale * chain_length)) ** 2
+                           + np.log(length / (scale * chord_len)) ** 2)
+        cost += W_DIRECTION * (1.0 - cos)
+    cost[~np.isfinite(cost)] = np.inf
+    np.fill_diagonal(cost, np.inf)
+    return cost
+
+
+def joint_costs(points, template_y, template_floor, floor, height, scale):
+    """(N,) cost of putting a joint at each graph vertex (its height).
+
+    Parameters
+    ----------
+    points : (N, 3) float64
+    template_y : float
+        The joint's template height.
+    template_floor : float
+        Lowest template joint height.
+    floor, height : float
+        The mesh's lowest point and height.
+    scale : float
+    """
+    expected = scale * (template_y - template_floor)
+    return W_HEIGHT * ((points[:, 1] - floor - expected) / (0.25 * height)) ** 2
+
+
+def mirror_cost(p, q, plane_x, unit):
+    """Cost of joint positions ``p`` (N, 3) against their partner's ``q`` (3,) mirrored
+    across x = ``plane_x``; ``unit`` is 5% of the template's size in mesh units."""
+    m = np.array([2.0 * plane_x - q[0], q[1], q[2]])
+    return W_MIRROR * np.sum((p - m) ** 2, axis=-1) / (unit * unit)

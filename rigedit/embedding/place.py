@@ -1,0 +1,103 @@
+"""From embedded reduced joints to every template joint.
+
+* Inner joints of a reduced bone's chain (elbows, knees, spine joints) follow the template
+  chain mapped onto the embedded bone: the template chain is turned by the least rotation
+  that takes its chord onto the embedded chord and scaled to the embedded chord's length,
+  so the template's bends and proportions along the chain are kept. Where the embedded
+  chain bends (a crouch, a bent elbow), ``bend`` pulls each inner joint to the point at
+  the same fraction of length along the chain's path through the medial graph.
+* Carried joints (short tips, a non-deforming root, unembedded optional branches) keep
+  their template offset from the nearest placed ancestor, turned like that ancestor's chain
+  and scaled by the global scale; a root above everything follows the reduced root.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+__all__ = ["least_rotation", "place_joints"]
+
+
+def least_rotation(a, b):
+    """The least rotation taking direction ``a`` (3,) onto direction ``b`` (3,)."""
+    a = np.asarray(a, float) / max(np.linalg.norm(a), 1e-300)
+    b = np.asarray(b, float) / max(np.linalg.norm(b), 1e-300)
+    axis = np.cross(a, b)
+    s, c = np.linalg.norm(axis), float(np.dot(a, b))
+    if s < 1e-12:
+        if c > 0:
+            return Rotation.identity()
+        # opposite: half a turn about any axis perpendicular to a
+        perp = np.cross(a, [1.0, 0, 0] if abs(a[0]) < 0.9 else [0, 1.0, 0])
+        return Rotation.from_rotvec(np.pi * perp / np.linalg.norm(perp))
+    return Rotation.from_rotvec(axis / s * np.arctan2(s, c))
+
+
+def _along(polyline, fractions):
+    """Points at arc-length ``fractions`` (K,) of a polyline (P, 3) -> (K, 3)."""
+    seg = np.linalg.norm(np.diff(polyline, axis=0), axis=1)
+    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    if cum[-1] <= 0:
+        return np.repeat(polyline[:1], len(fractions), axis=0)
+    return np.stack([np.interp(np.asarray(fractions) * cum[-1], cum, polyline[:, d])
+                     for d in range(3)], axis=1)
+
+
+def place_joints(template, reduced, scale, paths=None, bend=0.5):
+    """Positions of every template joint.
+
+    Parameters
+    ----------
+    template : ReducedTemplate
+    reduced : (R, 3) float64
+        Embedded reduced joints, NaN rows where carried.
+    scale : float
+        Mesh units per template unit.
+    paths : list of (P, 3) float64 or None, optional
+        For each reduced joint, the polyline of its embedded chain (parent to joint).
+    bend : float
+        How far inner joints move from the mapped template chain towards the path.
+
+    Returns
+    -------
+    (J, 3) float64
+    """
+    rest = template.rest
+    n = len(rest)
+    out = np.full((n, 3), np.nan)
+    turn = [None] * n
+    for r, j in enumerate(template.joints):
+        if np.all(np.isfinite(reduced[r])):
+            out[j] = reduced[r]
+    for r in range(1, len(template.joints)):
+        if not np.all(np.isfinite(reduced[r])):
+            continue
+        chain = template.chains[r]
+        a, b = chain[0], chain[-1]
+        rot = least_rotation(rest[b] - rest[a], out[b] - out[a])
+        k = np.linalg.norm(out[b] - out[a]) / max(np.linalg.norm(rest[b] - rest[a]), 1e-12)
+        inner = chain[1:-1]
+        if inner:
+            mapped = out[a] + k * rot.apply(rest[inner] - rest[a])
+            if paths is not None and paths[r] is not None and len(paths[r]) > 2 and bend > 0:
+                bones = np.linalg.norm(np.diff(rest[chain], axis=0), axis=1)
+                frac = np.cumsum(bones)[:-1] / max(bones.sum(), 1e-12)
+                mapped = (1.0 - bend) * mapped + bend * _along(paths[r], frac)
+            out[inner] = mapped
+        for j in chain[1:]:
+            turn[j] = rot
+    root = template.joints[0]
+    for j in range(n):
+        if np.all(np.isfinite(out[j])):
+            continue
+        p = template.parents[j]
+        while p >= 0 and not np.all(np.isfinite(out[p])):
+            p = template.parents[p]
+        if p < 0:
+            out[j] = out[root] + scale * (rest[j] - rest[root])
+            continue
+        rot = turn[p] or Rotation.identity()
+        out[j] = out[p] + scale * rot.apply(rest[j] - rest[p])
+        turn[j] = rot
+    return out
+

@@ -1,0 +1,180 @@
+"""Discrete embedding of the reduced skeleton into the medial graph: best-first search (A*).
+
+Each reduced joint goes to a graph vertex (or, for an optional branch, is carried). The
+cost is the sum of the bone and joint penalties (a tree: parent-child terms only) plus the
+mirror penalties between left and right. The tree part alone is minimised exactly by
+dynamic programming over the reduced tree; that minimum, for the joints not yet placed,
+is the search's lower bound, exact wherever the mirror terms vanish. Pinocchio's own
+bound is looser (it searches without the tree's exact cost-to-go); with this one the
+search places joints in order and rarely backs up, so it needs few expansions.
+
+Joints are placed parent before child; two joints never share a vertex, and limb ends the
+template keeps apart along its tree (the feet) must be apart along the graph too.
+"""
+from __future__ import annotations
+
+import heapq
+from dataclasses import dataclass
+
+import numpy as np
+
+from .penalties import (SEPARATE_RATIO, W_CARRY, bone_costs, joint_costs, mirror_cost)
+
+__all__ = ["Search", "discrete_embedding"]
+
+#: Children pushed per expansion (the cheapest by cost plus bound): the others are so much
+#: dearer that the search would never come back to them.
+BRANCH = 48
+#: Expansions before the search gives up and keeps the best complete embedding seen.
+MAX_EXPANSIONS = 20000
+
+
+@dataclass
+class Search:
+    """Result of :func:`discrete_embedding`.
+
+    Attributes
+    ----------
+    vertex : (R,) int
+        Graph vertex of each reduced joint, -1 where carried.
+    cost : float
+    expansions : int
+    failed : int
+        The reduced joint that could not be placed when ``vertex`` is None, else -1.
+    """
+
+    vertex: np.ndarray
+    cost: float
+    expansions: int
+    failed: int = -1
+
+
+def _separated_pairs(template):
+    """Reduced leaf pairs whose tree path is at least 3 times their distance (the feet)."""
+    rest = template.rest[template.joints]
+    parent = template.parent
+    r = len(parent)
+    children = [np.flatnonzero(parent == k) for k in range(r)]
+    leaves = [k for k in range(1, r) if len(children[k]) == 0 and not template.optional[k]]
+
+    def up(k):
+        out = {k: 0.0}
+        total = 0.0
+        while parent[k] >= 0:
+            total += template.chain_length[k]
+            k = parent[k]
+            out[k] = total
+        return out
+    pairs = []
+    for i, a in enumerate(leaves):
+        ua = up(a)
+        for b in leaves[i + 1:]:
+            ub = up(b)
+            tree = min(ua[k] + ub[k] for k in ua if k in ub)
+            if tree >= 3.0 * np.linalg.norm(rest[a] - rest[b]):
+                pairs.append((a, b))
+    return pairs
+
+
+def discrete_embedding(graph, template, frame, scale, progress=None):
+    """Embed ``template`` (a ReducedTemplate) into ``graph`` (a MedialGraph).
+
+    Parameters
+    ----------
+    frame : dict
+        ``floor``, ``height`` (of the mesh), ``plane_x`` (its middle plane).
+    scale : float
+        Mesh units per template unit.
+    progress : callable(fraction), optional
+        Called now and then with the fraction done (may raise to cancel).
+
+    Returns
+    -------
+    Search
+        ``vertex`` is None when nothing fits; ``failed`` then names the reduced joint.
+    """
+    pts, dist = graph.points, graph.dist
+    r = len(template.joints)
+    n = len(pts)
+    parent = template.parent
+    children = [np.flatnonzero(parent == k) for k in range(r)]
+    rest = template.rest[template.joints]
+    deform_floor = float(template.rest[~template.carried, 1].min())
+    unary = np.stack([joint_costs(pts, rest[k, 1], deform_floor, frame["floor"],
+                                  frame["height"], scale) for k in range(r)])
+    pair = [None] + [bone_costs(pts, dist, rest[k] - rest[parent[k]], template.chain_length[k],
+                                scale) for k in range(1, r)]
+    # down[k][v]: exact least tree cost of k's subtree with k at v.
+    # best[k][a]: least cost of k's subtree given its parent at a (carrying included).
+    down = [None] * r
+    best = [None] * r
+    for k in range(r - 1, -1, -1):
+        down[k] = unary[k] + sum((best[c] for c in children[k]), np.zeros(n))
+        if k > 0:
+            best[k] = np.min(pair[k] + down[k][None, :], axis=1)
+            if template.optional[k]:
+                best[k] = np.minimum(best[k], W_CARRY)
+    unit = 0.05 * template.size * scale
+    sep = _separated_pairs(template)
+    partner = {}
+    for a, b in sep:
+        partner.setdefault(max(a, b), []).append(min(a, b))
+
+    def bound(k, v):
+        return sum(best[c][v] for c in children[k]) if v >= 0 else 0.0
+
+    heap = []
+    f0 = down[0]
+    for v in np.argsort(f0)[:BRANCH]:
+        if np.isfinite(f0[v]):
+            heap.append((float(f0[v]), float(unary[0][v]), (int(v),)))
+    heapq.heapify(heap)
+    expansions = 0
+    stuck = np.zeros(r, dtype=np.int64)
+    best_full = None
+    while heap:
+        f, g, assign = heapq.heappop(heap)
+        k = len(assign)
+        if k == r:
+            return Search(np.asarray(assign), g, expansions)
+        expansions += 1
+        if expansions % 200 == 0 and progress is not None:
+            progress(min(1.0, expansions / MAX_EXPANSIONS))
+        if expansions > MAX_EXPANSIONS:
+            break
+        a = assign[parent[k]]
+        h_rest = f - g - (best[k][a] if a >= 0 else 0.0)
+        if a < 0:  # the parent is carried, so is this joint
+            heapq.heappush(heap, (f, g, assign + (-1,)))
+            continue
+        used = np.array([v for v in assign if v >= 0])
+        gk = pair[k][a] + unary[k]
+        m = template.mirror[k]
+        if 0 <= m < k and assign[m] >= 0:
+            gk = gk + mirror_cost(pts, pts[assign[m]], frame["plane_x"], unit)
+        for q in partner.get(k, []):
+            if assign[q] >= 0:
+                apart = np.linalg.norm(pts - pts[assign[q]], axis=1)
+                gk = np.where(dist[assign[q]] >= SEPARATE_RATIO * apart, gk, np.inf)
+        gk[used] = np.inf
+        hk = sum((best[c] for c in children[k]), np.zeros(n))
+        fk = g + gk + hk + h_rest
+        order = np.argsort(fk)[:BRANCH]
+        order = order[np.isfinite(fk[order])]
+        if len(order) == 0:
+            stuck[k] += 1
+        for v in order:
+            heapq.heappush(heap, (float(fk[v]), float(g + gk[v]), assign + (int(v),)))
+        if template.optional[k]:
+            heapq.heappush(heap, (g + W_CARRY + h_rest, g + W_CARRY, assign + (-1,)))
+    if best_full is None:
+        return Search(None, np.inf, expansions, failed=int(np.argmax(stuck)) if stuck.any()
+                      else _first_unplaceable(best, template))
+    return best_full
+
+
+def _first_unplaceable(best, template):
+    for k in range(1, len(best)):
+        if not template.optional[k] and not np.isfinite(best[k]).any():
+            return k
+    return 1
