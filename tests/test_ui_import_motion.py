@@ -37,13 +37,19 @@ def _choose(monkeypatch, path):
     return asked
 
 
-def _import(w, qtbot, monkeypatch, path):
+def _import(w, qtbot, monkeypatch, path, add=True):
+    """Import ``path`` through the menu; with ``add``, press Add clip in the joint map
+    dialog (when the retarget gave a clip). Returns the dialog (None when none opened)."""
     asked = _choose(monkeypatch, path)
     menu_action(w, "File", "Import motion onto this character").trigger()
     # reading, then retargeting (a second job started when the first one ends)
     # (no event runs between the two: job is None only when both ended)
     qtbot.waitUntil(lambda: w.job is None, timeout=120000)
     assert asked == ["Import motion onto this character"]
+    dialog = w.motion_import.dialog
+    if add and dialog is not None and dialog.add_button.isEnabled():
+        dialog.add_button.click()
+    return dialog
 
 
 def _state(doc):
@@ -84,9 +90,10 @@ def test_import_bandai_walk_adds_one_moving_clip_as_one_undo_step(humanoid_windo
     assert travel > 0.3, travel   # metres in about one second of walking
     msg = w.statusBar().currentMessage()
     assert f"Imported {WALK.name}" in msg
-    mapped = int(msg.split("joint map ")[1].split(" mapped")[0])
+    mapped = int(msg.split("joint map automatic, ")[1].split(" mapped")[0])
     assert 10 <= mapped <= len(doc.skeleton)
     assert f"{len(doc.skeleton) - mapped} of this character's joints unmapped" in msg
+    assert "joint map automatic" in msg
 
     added = clip
     doc.undo()
@@ -133,11 +140,16 @@ def test_import_motion_without_legs_changes_nothing_and_names_the_file(humanoid_
     doc = w.document
     before, steps = _state(doc), len(doc.undo_stack)
 
-    _import(w, qtbot, monkeypatch, motion)
+    dialog = _import(w, qtbot, monkeypatch, motion)
 
     assert _state(doc) == before
     assert len(doc.undo_stack) == steps
     assert "stick.bvh" in w.last_error
+    # the map stays open to be mended, with no clip to add
+    assert dialog.isVisible() and not dialog.add_button.isEnabled()
+    assert dialog.summary.text().startswith("No clip: ")
+    dialog.cancel_button.click()
+    assert w.motion_import.dialog is None and _state(doc) == before
 
 
 def test_import_from_rig_folder_asks_which_clip(humanoid_window, qtbot, monkeypatch):

@@ -183,6 +183,7 @@ class AutorigDialog(QtWidgets.QDialog):
             self.template_label.setText(str(self.template_file))
         else:
             self.template_label.setText("")
+        self.template_label.setVisible(bool(self.template_label.text()))
         problem = self._problem()
         self.problem_label.setText(problem)
         self.ok_button.setEnabled(not problem)

@@ -2,10 +2,13 @@
 the open rig (:func:`rigedit.rigging.retarget_result`) and add it as a new clip.
 
 Reading the motion and retargeting run off the UI thread (:meth:`MainWindow.run_job`; the
-retarget cannot report its progress, so the bar is indeterminate). The new clip is added by the
-timeline as one undo step and becomes the current clip. Bad input (an unreadable file, a motion
-whose joints map to nothing, a target without legs) gives one message naming the file, and the
-document is left as it was.
+retarget cannot report its progress, so the bar is indeterminate). The joint map used is then
+shown (:class:`~rigedit.ui.joint_map_dialog.JointMapDialog`, not modal: the character stays in
+view): it can be edited there or loaded from JSON and the retarget run again, and saved, as
+``rigedit retarget --map/--save-map`` do. Add clip adds the clip by the timeline as one undo
+step and makes it current. Bad input (an unreadable file, a motion whose joints map to nothing,
+a target without legs, a map naming unknown joints) gives one message naming the file, and the
+document is left as it was; when the retarget fails, the map stays open to be mended.
 """
 from __future__ import annotations
 
@@ -19,6 +22,7 @@ from ..animation.clip_names import check_clip_name
 
 __all__ = ["ImportMotion", "motion_path"]
 
+MAP_FILTERS = "Joint map (*.json);;All files (*)"
 FILTERS = ("Motion (*.bvh *.glb *.gltf skeleton.json);;BVH (*.bvh);;glTF (*.glb *.gltf);;"
            "Rig folder (skeleton.json)")
 
@@ -54,6 +58,8 @@ class ImportMotion:
 
     def __init__(self, window):
         self.w = window
+        self.ctx = None      # the import under way: motion, clip, target, last result
+        self.dialog = None   # its joint map dialog
 
     def run(self, path=None):
         """Ask for a motion file (or take ``path``) and start reading it. Returns the job."""
@@ -81,36 +87,158 @@ class ImportMotion:
                 self.w.status("Import motion: cancelled")
                 return None
         doc = self.w.document
-        rig, skeleton = doc.rig, doc.skeleton
         # the job reads a snapshot of the clips: the user may edit them meanwhile
-        target = SimpleNamespace(skeleton=skeleton, clips=dict(doc.clips))
-        base = _clip_name(path, name, len(names) > 1)
+        ctx = SimpleNamespace(path=path, source=source, clip=name, rig=doc.rig,
+                              skeleton=doc.skeleton, res=None,
+                              target=SimpleNamespace(skeleton=doc.skeleton,
+                                                     clips=dict(doc.clips)),
+                              base=_clip_name(path, name, len(names) > 1))
+        self._close_dialog()
+        self.ctx = ctx
+        return self.retarget(None)
+
+    # ------------------------------------------------------------------ the map
+    def retarget(self, mapping=None, how=None):
+        """Retarget the chosen clip with ``mapping`` (None: the automatic map) off the UI
+        thread; the joint map dialog then shows the map used. Returns the job."""
+        ctx = self.ctx
+        if ctx is None:
+            return None
+        how = how or ("automatic" if mapping is None else "edited")
 
         def work(report):
             from ..rigging import retarget_result
 
             report(None)
-            return retarget_result(source, name, target, source_what=str(path),
-                                   target_what=rig.name or "this character")
+            try:
+                return retarget_result(ctx.source, ctx.clip, ctx.target, mapping,
+                                       source_what=str(ctx.path),
+                                       target_what=ctx.rig.name or "this character")
+            except ValueError as exc:  # no legs mapped, ...: shown, and the map stays editable
+                return exc
 
-        return self.w.run_job(f"Retargeting {path.name}", work,
-                              lambda res: self._done(path, res, base, rig, skeleton,
-                                                     len(source.skeleton)))
+        if self.dialog is not None:
+            self.dialog.set_busy(True)
+        job = self.w.run_job(f"Retargeting {ctx.path.name}", work,
+                             lambda res: self._retargeted(ctx, res, mapping, how),
+                             on_cancel=lambda: self._idle(ctx))
+        if job is None:
+            self._idle(ctx)
+        return job
 
-    def _done(self, path, res, base, rig, skeleton, n_source):
+    def _idle(self, ctx):
+        if self.dialog is not None and ctx is self.ctx:
+            self.dialog.set_busy(False)
+
+    def _retargeted(self, ctx, res, mapping, how):
+        if ctx is not self.ctx:
+            return None
+        n_source = len(ctx.source.skeleton)
+        n_target = len(ctx.skeleton)
+        if isinstance(res, ValueError):
+            ctx.res = None
+            text = f"No clip: {res}"
+            self.w.error("Import motion", str(res))
+        else:
+            ctx.res = res
+            mapped = len(res.mapping)
+            ctx.summary = (f"joint map {how}, {mapped} mapped, {n_target - mapped} of this "
+                           f"character's joints unmapped, {n_source - mapped} of the "
+                           f"motion's unused")
+            text = (f"{ctx.path.name}, clip {ctx.clip!r} ({res.clip.duration:.2f} s): "
+                    f"{ctx.summary}. Unmapped joints of this character keep their rest pose.")
+        dialog = self._dialog(ctx)
+        dialog.show_result(None if ctx.res is None else ctx.res.mapping, text)
+        dialog.set_busy(False)
+        if ctx.res is None and mapping is not None:
+            dialog.set_mapping(mapping)  # the failed map stays on show, to be mended
+        dialog.show()
+        dialog.raise_()
+        return ctx.res
+
+    def _dialog(self, ctx):
+        from .joint_map_dialog import JointMapDialog
+
+        if self.dialog is None:
+            d = JointMapDialog(ctx.source.skeleton.names, ctx.skeleton.names,
+                               f"{ctx.path.name}, clip {ctx.clip}", self.w)
+            d.retarget.connect(self.retarget)
+            d.load_requested.connect(self.load_map)
+            d.save_requested.connect(self.save_map)
+            d.accepted.connect(self._add)
+            d.rejected.connect(self._cancel)
+            self.dialog = d
+        return self.dialog
+
+    def _close_dialog(self):
+        if self.dialog is not None:
+            self.dialog.blockSignals(True)
+            self.dialog.close()
+            self.dialog.deleteLater()
+        self.dialog = None
+
+    def load_map(self, path=None):
+        """Read a JSON map ``{motion joint: character joint}`` (checked against both
+        skeletons) and retarget with it. Returns the job, or None."""
+        ctx = self.ctx
+        if not isinstance(path, (str, Path)):
+            path, _ = QtWidgets.QFileDialog.getOpenFileName(
+                self.dialog or self.w, "Load joint map", "", MAP_FILTERS)
+        if not path or ctx is None:
+            return None
+        from ..rigging import load_map
+
+        try:
+            mapping = load_map(path, ctx.source.skeleton, ctx.skeleton)
+        except (ValueError, OSError) as exc:
+            self.w.error("Load joint map", str(exc))
+            return None
+        if self.dialog is not None:
+            self.dialog.set_mapping(mapping)
+        return self.retarget(mapping, how=f"from {Path(path).name}")
+
+    def save_map(self, path=None):
+        """Write the map on show as JSON (what ``--map`` reads). Returns True when written."""
+        if self.dialog is None:
+            return False
+        if not isinstance(path, (str, Path)):
+            path, _ = QtWidgets.QFileDialog.getSaveFileName(
+                self.dialog, "Save joint map", f"{self.ctx.path.stem}_map.json", MAP_FILTERS)
+        if not path:
+            return False
+        from ..rigging import save_map
+
+        try:
+            save_map(path, self.dialog.mapping())
+        except (ValueError, OSError) as exc:
+            self.w.error("Save joint map", f"{path}: {exc}")
+            return False
+        self.w.status(f"Saved the joint map ({len(self.dialog.mapping())} joints) to {path}")
+        return True
+
+    def _cancel(self):
+        self.ctx = None
+        self._close_dialog()
+        self.w.status("Import motion: cancelled")
+
+    # ------------------------------------------------------------------ the clip
+    def _add(self):
+        ctx, self.ctx = self.ctx, None
+        self._close_dialog()
+        if ctx is None or ctx.res is None:
+            return None
+        path, res = ctx.path, ctx.res
         doc = self.w.document
-        if doc.rig is not rig or doc.skeleton is not skeleton:
-            what = "another rig was opened" if doc.rig is not rig else "the skeleton changed"
+        if doc.rig is not ctx.rig or doc.skeleton is not ctx.skeleton:
+            what = "another rig was opened" if doc.rig is not ctx.rig else \
+                "the skeleton changed"
             self.w.error("Import motion", f"{path}: import dropped: {what} while it was "
                                           f"retargeted; import it again")
             return None
         clip = res.clip
-        added = self.w.timeline.add_clip(clip, base, f"Import motion {path.name}")
+        added = self.w.timeline.add_clip(clip, ctx.base, f"Import motion {path.name}")
         if added is None:
             return None
-        mapped = len(res.mapping)
-        self.w.status(
-            f"Imported {path.name} as clip {added!r} ({clip.duration:.2f} s): joint map "
-            f"{mapped} mapped, {len(skeleton) - mapped} of this character's joints unmapped, "
-            f"{n_source - mapped} of the motion's unused")
+        self.w.status(f"Imported {path.name} as clip {added!r} ({clip.duration:.2f} s): "
+                      f"{ctx.summary}")
         return added
