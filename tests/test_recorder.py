@@ -152,7 +152,7 @@ def test_frame_reader_reads_what_screenshot_reads(rig, backdrop):
         other.close()
 
 
-def test_frame_reader_keeps_the_gradient_under_a_translucent_floor(rig):
+def test_frame_reader_keeps_the_gradient_under_a_translucent_mesh(rig):
     import pyvista as pv
 
     from rigedit.render.recorder import FrameReader
@@ -162,7 +162,8 @@ def test_frame_reader_keeps_the_gradient_under_a_translucent_floor(rig):
     try:
         plotter.disable_anti_aliasing()
         plotter.set_background("#eef1f4", top="#c5ccd6")
-        RigScene(plotter, rig)   # the filled floor blends with the background behind it
+        # the translucent mesh blends with the background behind it
+        RigScene(plotter, rig, show_floor=False).set_display_mode("translucent")
         shot = plotter.screenshot(return_img=True)
         reader = FrameReader(plotter, buffers=2, backdrop=True)
         assert reader.backdrop is None and plotter.renderer.GetGradientBackground()

@@ -59,6 +59,44 @@ def joint_points(rig, model):
     return np.vstack([model[:, :3, 3], rig.posed_tails(model)[1]])
 
 
+#: The floor's plane and grid line colours and how much of them shows over the background
+#: (:func:`floor_colors`): chosen so that the opaque floor shows the pixels the translucent,
+#: lit floor it replaced showed over the editor's background, within a few levels
+FLOOR_COLOR, FLOOR_ALPHA = "#85857f", 0.2
+GRID_COLOR, GRID_ALPHA = "#6b7580", 0.45
+
+
+def floor_colors(points, center, radius, renderer):
+    """Opaque colours for the floor's points that look like a translucent floor over the
+    renderer's background: the floor colour blended over the background, over its lower
+    colour near the character and over the middle of a gradient background towards the
+    floor's far edge (which shows near the horizon), so the floor fades into the distance.
+
+    Parameters
+    ----------
+    points : (N, 3) float
+    center : (3,) float
+        The floor's centre, under the character.
+    radius : float
+        Distance from the centre at which the far colour is reached.
+    renderer : vtkRenderer
+
+    Returns
+    -------
+    plane, grid : (N, 3) uint8 each
+        RGB of the filled plane and of the grid lines drawn over it.
+    """
+    near = np.array(renderer.GetBackground())
+    far = 0.5 * (near + np.array(renderer.GetBackground2())) \
+        if renderer.GetGradientBackground() else near
+    d = np.linalg.norm(np.asarray(points, float) - center, axis=1) / radius
+    t = np.clip(d, 0.0, 1.0)[:, None]
+    behind = near + (far - near) * (t * t * (3 - 2 * t))  # smoothstep
+    plane = behind + FLOOR_ALPHA * (np.array(pv.Color(FLOOR_COLOR).float_rgb) - behind)
+    grid = plane + GRID_ALPHA * (np.array(pv.Color(GRID_COLOR).float_rgb) - plane)
+    return tuple(np.clip(np.rint(255 * c), 0, 255).astype(np.uint8) for c in (plane, grid))
+
+
 def faces_to_vtk(faces):
     """(F, 3) triangles -> pyvista's flat ``[3, a, b, c, ...]`` cell array."""
     faces = np.asarray(faces, dtype=np.int64)
@@ -76,9 +114,10 @@ class RigScene:
     show_floor : bool
     skinning : {"lbs", "dqs"}
     skinned_normals : bool
-        LBS only, for a fixed skinning method (the recorder): normals blended with the
-        vertices in one pass (``SkinBinding.skin_with_normals``) instead of recomputed by VTK
-        each frame; exact in the rest pose, within shading noise when posed.
+        Normals blended with the vertices in one pass (``SkinBinding.skin_with_normals``)
+        instead of recomputed by ``vtkPolyDataNormals`` each frame: exact in the rest pose,
+        within shading noise when posed (README, Speed). Used while :attr:`skinning` is
+        "lbs"; with "dqs" the filter runs (the DQS kernel blends no normals).
 
     Attributes
     ----------
@@ -89,14 +128,14 @@ class RigScene:
     """
 
     def __init__(self, plotter, rig, show_skeleton=True, show_floor=True, skinning="lbs",
-                 skinned_normals=False):
+                 skinned_normals=True):
         self.plotter = plotter
         self.rig = rig
-        #: The skinning method of every update: "lbs" or "dqs" (SkinBinding.skin)
-        self.skinning = skinning
+        self._skinning = skinning
         #: Normals blended in the LBS pass from rest normals (VTK's, computed once) instead
-        #: of vtkPolyDataNormals on every changed frame; LBS only
-        self.skinned_normals = bool(skinned_normals) and skinning == "lbs"
+        #: of vtkPolyDataNormals on every changed frame, when the method is LBS
+        self.use_skinned_normals = bool(skinned_normals)
+        self._normals_binding = None  # the binding whose rest normals were computed
         self.up = up_vector(rig.up)
         self.front = front_vector(rig.up)
         #: False for a rig with no mesh (a BVH skeleton): no mesh actor, the skeleton drawn
@@ -114,14 +153,12 @@ class RigScene:
             self._normals.ConsistencyOff()
             self._normals.AutoOrientNormalsOff()
             self._normals.ComputeCellNormalsOff()
-            shown = self._normals
-            if self.skinned_normals:
-                shown = self._bind_skinned_normals()
             look = self._surface_look()
-            self.mesh_actor = plotter.add_mesh(shown, smooth_shading=True,
+            self.mesh_actor = plotter.add_mesh(self._normals, smooth_shading=True,
                                                specular=0.25, specular_power=20,
                                                name="rig-mesh", **look)
             self._texture = look.get("texture")
+            self._connect_normals()
         sk = rig.skeleton
         # No line from a non-deforming root (a ground-level carrier) to its children: that
         # "bone" moves no skin and would cut through the body down to the floor.
@@ -147,27 +184,68 @@ class RigScene:
         self.view("front")
 
     # ------------------------------------------------------------------ actors
-    def _bind_skinned_normals(self):
-        """Give the binding rest normals from the same filter (run once on the bind-space
-        vertices) and the mesh a "Normals" array that each update fills: in the rest pose the
-        shading is the filter's exactly; posed, each normal turns with its vertex's blend.
+    @property
+    def skinning(self):
+        """The skinning method of every update: "lbs" or "dqs" (``SkinBinding.skin``);
+        setting it also picks where the normals come from."""
+        return self._skinning
 
-        Returns
-        -------
-        mesh : pyvista.PolyData
-            ``self.mesh``, drawn directly (no filter in its pipeline).
-        """
+    @skinning.setter
+    def skinning(self, method):
+        self._skinning = method
+        self._connect_normals()
+
+    @property
+    def skinned_normals(self):
+        """Whether the shown normals are skinned with the vertices (else VTK's filter)."""
+        return self.has_mesh and self.use_skinned_normals and self._skinning == "lbs"
+
+    def _connect_normals(self):
+        """Feed the mapper the mesh itself (its "Normals" array skinned by each update) or
+        the normals filter's output (recomputed from the points), as :attr:`skinned_normals`
+        says."""
+        if self.mesh_actor is None:
+            return
+        mapper = self.mesh_actor.GetMapper()
+        data = self.mesh.point_data
+        if self.skinned_normals:
+            if "Normals" not in data:
+                # until the next update: the filter's normals of the current points, or
+                # the rest normals when the filter never ran
+                shown = self._normals.GetOutput().GetPointData().GetNormals()
+                n = self.mesh.n_points
+                data.set_array(np.array(pv.convert_array(shown), np.float32)
+                               if shown is not None and shown.GetNumberOfTuples() == n
+                               else np.zeros((n, 3), np.float32), "Normals")
+            data.active_normals_name = "Normals"
+            self._bind_rest_normals()
+            mapper.SetInputData(self.mesh)
+        else:
+            # VTK 9.7's vtkPolyDataNormals passes normals already on its input through
+            # instead of computing them: the filter must see none
+            if "Normals" in data:
+                data.remove("Normals")
+            mapper.SetInputConnection(self._normals.GetOutputPort())
+        self.mesh.Modified()
+
+    def _bind_rest_normals(self):
+        """Give the rig's binding rest normals from the same filter (run once on the
+        bind-space vertices), so that in the rest pose the shading is the filter's exactly
+        and, posed, each normal turns with its vertex's blend. Done again when the document
+        replaced the binding (a re-bind)."""
         binding = self.rig.binding
+        if binding is self._normals_binding:
+            return
         rest = pv.PolyData(np.asarray(binding.rest_vertices, dtype=np.float32),
                            self.mesh.GetPolys())
         self._normals.SetInputData(rest)
         self._normals.Update()
-        binding.bind_normals(pv.wrap(self._normals.GetOutput()).point_data["Normals"])
+        rest_normals = pv.wrap(self._normals.GetOutput()).point_data["Normals"]
+        binding.bind_normals(rest_normals)
         self._normals.SetInputData(self.mesh)
-        self.mesh.point_data.set_array(np.zeros((self.mesh.n_points, 3), np.float32),
-                                       "Normals")
-        self.mesh.point_data.active_normals_name = "Normals"
-        return self.mesh
+        if self._normals_binding is None:  # the mesh still shows the bind-space vertices
+            self.mesh.point_data["Normals"][:] = rest_normals
+        self._normals_binding = binding
 
     def _surface_look(self):
         """``add_mesh`` colour/texture arguments from the rig's surface: its materials as one
@@ -236,9 +314,19 @@ class RigScene:
         ground[axis] = min(0.0, lo[axis]) if lo[axis] > -0.05 * extent else lo[axis]
         plane = pv.Plane(center=ground, direction=self.up, i_size=size, j_size=size,
                          i_resolution=cells, j_resolution=cells)
-        self.plotter.add_mesh(plane, color="#9aa3ad", opacity=0.35, name="rig-floor",
-                              reset_camera=False, pickable=False)
-        return self.plotter.add_mesh(plane.extract_all_edges(), color="#6b7580", opacity=0.5,
+        # Opaque and unlit, in colours that look like the translucent lit floor it replaces
+        # over the background: a translucent plane cost a third of the editor's frame in
+        # software OpenGL and a lit one a fifth (README, Speed > Dragging).
+        grid = plane.extract_all_edges()
+        renderer = self.plotter.renderer
+        plane.point_data["floor-rgb"] = floor_colors(plane.points, ground, size / 2,
+                                                     renderer)[0]
+        grid.point_data["floor-rgb"] = floor_colors(grid.points, ground, size / 2, renderer)[1]
+        fill = self.plotter.add_mesh(plane, scalars="floor-rgb", rgb=True, lighting=False,
+                                     name="rig-floor", reset_camera=False, pickable=False)
+        # the plane pushed back in depth so the opaque lines on it never fight it
+        fill.GetMapper().SetRelativeCoincidentTopologyPolygonOffsetParameters(4.0, 4.0)
+        return self.plotter.add_mesh(grid, scalars="floor-rgb", rgb=True, lighting=False,
                                      name="rig-grid", reset_camera=False, pickable=False)
 
     def set_skeleton_visible(self, visible):
@@ -335,6 +423,7 @@ class RigScene:
         elif skin:
             palette = skinning_matrices(self.rig.skeleton, model)
             if self.skinned_normals:
+                self._bind_rest_normals()
                 points, normals = self.rig.binding.skin_with_normals(palette)
                 self.mesh.point_data["Normals"][:] = normals
                 self.mesh.GetPointData().GetNormals().Modified()
