@@ -82,14 +82,18 @@ def test_exception_in_a_vtk_observer_is_shown_not_warned(editor, cache, monkeypa
     def broken(j, target):
         raise RuntimeError("IK diverged")
 
-    monkeypatch.setattr(editor, "drag_step", broken)
-    w = editor.gizmos.widgets[4]
+    monkeypatch.setattr(editor.drag, "step", broken)
+    editor.plotter.render()
+    x, y = (int(round(v)) for v in editor.gizmos.display_position(4))
+    iren = editor.plotter.iren.interactor
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        w.InvokeEvent("StartInteractionEvent")
-        w.SetCenter(*(np.array(w.GetCenter()) + 0.1))
-        w.InvokeEvent("InteractionEvent")
-        w.InvokeEvent("EndInteractionEvent")
+        iren.SetEventInformation(x, y)
+        iren.InvokeEvent("LeftButtonPressEvent")  # a real press and move, in VTK observers
+        assert editor.gizmos.active is not None
+        iren.SetEventInformation(x + 12, y + 6)
+        iren.InvokeEvent("MouseMoveEvent")
+        iren.InvokeEvent("LeftButtonReleaseEvent")
     assert [c for c in caught if issubclass(c.category, RuntimeWarning)] == []
     assert "joint gizmo callback failed: RuntimeError: IK diverged" in \
         editor.error_display.label.text()
@@ -166,12 +170,15 @@ def test_window_fixture_still_fails_a_test_whose_vtk_callback_raised(tmp_path):
         "def test_drag_with_a_broken_step(window, monkeypatch):\n"
         "    def broken(j, target):\n"
         "        raise RuntimeError('boom in drag_step')\n\n"
-        "    monkeypatch.setattr(window, 'drag_step', broken)\n"
-        "    w = window.gizmos.widgets[5]\n"
-        "    w.InvokeEvent('StartInteractionEvent')\n"
-        "    w.SetCenter(*(np.array(w.GetCenter()) + 0.1))\n"
-        "    w.InvokeEvent('InteractionEvent')\n"
-        "    w.InvokeEvent('EndInteractionEvent')\n")
+        "    monkeypatch.setattr(window.drag, 'step', broken)\n"
+        "    window.plotter.render()\n"
+        "    x, y = (int(round(v)) for v in window.gizmos.display_position(5))\n"
+        "    iren = window.plotter.iren.interactor\n"
+        "    iren.SetEventInformation(x, y)\n"
+        "    iren.InvokeEvent('LeftButtonPressEvent')\n"
+        "    iren.SetEventInformation(x + 12, y + 6)\n"
+        "    iren.InvokeEvent('MouseMoveEvent')\n"
+        "    iren.InvokeEvent('LeftButtonReleaseEvent')\n")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(
         [str(tests), os.environ.get("PYTHONPATH", "")])}
     proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",

@@ -175,7 +175,7 @@ def test_open_mesh_and_skeleton_from_the_menu(demo_window, qtbot, tmp_path, monk
     np.testing.assert_array_equal(rig.binding.indices, idx)
     np.testing.assert_allclose(rig.binding.weights, w, rtol=0, atol=1e-14)
     # the view shows the new rig at rest, history starts afresh
-    assert len(window.gizmos.widgets) == len(rig.skeleton)
+    assert len(window.gizmos) == len(rig.skeleton)
     np.testing.assert_allclose(window.scene.mesh.points, rig.vertices, atol=1e-5)
     assert len(window.document.undo_stack) == 0
     assert window.info_panel.labels["Vertices"].text() == f"{len(rig.vertices):,}"

@@ -60,18 +60,13 @@ def bvh_window(qtbot, tmp_path):
         yield w
 
 
-def _fire_drag(widget, new_center):
-    widget.InvokeEvent("StartInteractionEvent")
-    widget.SetCenter(*new_center)
-    widget.InvokeEvent("InteractionEvent")
-    widget.InvokeEvent("EndInteractionEvent")
 
 
 def test_opens_with_bones_spheres_and_no_mesh(bvh_window):
     w = bvh_window
     rig = w.document.rig
     assert w.scene.mesh_actor is None and w.scene.mesh.n_points == 0
-    assert len(w.gizmos.widgets) == len(rig.skeleton) == 5
+    assert len(w.gizmos) == len(rig.skeleton) == 5
     # the first frame of the motion is shown, not the rest pose
     first = rig.joint_matrices(rig.clips["take"].sample(0.0))[:, :3, 3]
     np.testing.assert_allclose(w.gizmos.center(0), first[0], atol=1e-9)
@@ -94,7 +89,7 @@ def test_drag_a_joint_key_it_and_play(bvh_window, qtbot):
     w.chain_length = 1
     w.timeline.set_time(1.0)  # the last frame
     start = w.gizmos.center(head).copy()
-    _fire_drag(w.gizmos.widgets[head], start + np.array([0.3, 0.0, 0.0]))
+    w.gizmos.drag(head, start + np.array([0.3, 0.0, 0.0]))
     assert len(doc.undo_stack) == 1 and doc.selection == head
     dragged = rig.joint_matrices(doc.pose)[:, :3, 3]
     assert dragged[head, 0] > start[0] + 0.05  # the head swung towards the drag
@@ -137,7 +132,7 @@ def test_file_open_bvh_and_export_bvh(bvh_window, qtbot, tmp_path):
     qtbot.waitUntil(lambda: w.document.rig.name == "other", timeout=10000)
     rig = w.document.rig
     assert "units: guessed centimetres" in w.statusBar().currentMessage()
-    assert len(w.gizmos.widgets) == 5 and w.scene.mesh_actor is None
+    assert len(w.gizmos) == 5 and w.scene.mesh_actor is None
     out = tmp_path / "out.bvh"
     assert w.files.export(str(out))
     back = load_bvh(out, scale=0.01)
@@ -164,7 +159,7 @@ def test_edit_mode_moves_a_rest_joint_of_a_skeleton(bvh_window, qtbot):
     w.set_mode("edit")
     start = w.gizmos.center(foot).copy()
     target = start + np.array([0.05, 0.0, 0.0])
-    _fire_drag(w.gizmos.widgets[foot], target)
+    w.gizmos.drag(foot, target)
     qtbot.waitUntil(lambda: w.job is None, timeout=30000)
     assert doc.skeleton is not sk0
     np.testing.assert_allclose(doc.skeleton.bind_matrices[foot, :3, 3], target, atol=1e-9)

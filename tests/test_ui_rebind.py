@@ -17,34 +17,29 @@ from ui_window_fixture import limb_joint  # noqa: E402
 def gate(monkeypatch):
     """Holds every re-bind and weights job open until ``gate.set()`` (cancel still works
     meanwhile)."""
-    from rigedit.ui import drag, file_actions
+    from rigedit.ui import file_actions, rebind
 
     event = threading.Event()
-    real = drag.weights_in_chunks
+    real = rebind.weights_in_chunks
 
     def slow(vertices, skeleton, *args, report=None, **kw):
         while not event.wait(0.01):
             report(0.0)  # raises Cancelled once the user cancelled
         return real(vertices, skeleton, *args, report=report, **kw)
 
-    monkeypatch.setattr(drag, "weights_in_chunks", slow)
+    monkeypatch.setattr(rebind, "weights_in_chunks", slow)
     monkeypatch.setattr(file_actions, "weights_in_chunks", slow)
     yield event
     event.set()
 
 
-def _fire_drag(widget, new_center):
-    widget.InvokeEvent("StartInteractionEvent")
-    widget.SetCenter(*new_center)
-    widget.InvokeEvent("InteractionEvent")
-    widget.InvokeEvent("EndInteractionEvent")
 
 
 def _start_rebind(window, j, up=0.05):
     window.set_mode("edit")
     start = window.gizmos.center(j)
     target = start + np.array([0.0, up, 0.0]) * window.document.rig.height()
-    _fire_drag(window.gizmos.widgets[j], target)
+    window.gizmos.drag(j, target)
     assert window.job is not None and window.job.isRunning()
     return target
 
@@ -69,8 +64,7 @@ def test_pose_edits_made_while_rebinding_are_kept(window, qtbot, gate):
     # and type an angle into the joint panel.
     window.set_mode("pose")
     window.chain_length = 1
-    _fire_drag(window.gizmos.widgets[head],
-               window.gizmos.center(head) + np.array([0.0, 0.0, 0.15]) * doc.rig.height())
+    window.gizmos.drag(head, window.gizmos.center(head) + np.array([0.0, 0.0, 0.15]) * doc.rig.height())
     s1 = _state(doc)
     assert not np.array_equal(s1[2], s0[2])
     doc.select(j)
@@ -107,15 +101,14 @@ def test_rebind_finishing_during_a_pose_drag_waits_for_its_end(window, qtbot, ga
     _start_rebind(window, j)
     window.set_mode("pose")
     window.chain_length = 1
-    w = window.gizmos.widgets[head]
-    w.InvokeEvent("StartInteractionEvent")
-    w.SetCenter(*(window.gizmos.center(head) + np.array([0.0, 0.0, 0.15]) * doc.rig.height()))
-    w.InvokeEvent("InteractionEvent")
+    g = window.gizmos
+    g.start_drag(head)
+    g.drag_to(g.center(head) + np.array([0.0, 0.0, 0.15]) * doc.rig.height())
     gate.set()
     qtbot.waitUntil(lambda: window.job is None, timeout=30000)
     qtbot.wait(200)
     assert doc.skeleton is sk and doc.dragging  # held back while the drag is held
-    w.InvokeEvent("EndInteractionEvent")
+    g.end_drag()
     s1 = (sk, s0[1], doc.pose_snapshot())
     qtbot.waitUntil(lambda: doc.skeleton is not sk, timeout=5000)
     s2 = _state(doc)
@@ -135,7 +128,7 @@ def test_second_rest_move_while_rebinding_is_refused(window, qtbot, gate):
     k = sk.index["head"]
     head_rest = sk.bind_matrices[k, :3, 3].copy()
     target = _start_rebind(window, j)
-    _fire_drag(window.gizmos.widgets[k], window.gizmos.center(k) + [0.0, 0.2, 0.0])
+    window.gizmos.drag(k, window.gizmos.center(k) + [0.0, 0.2, 0.0])
     message = window.statusBar().currentMessage()
     assert "Busy" in message and "head keeps its rest position" in message
     assert window.last_error is None  # a status message, no error dialog

@@ -19,23 +19,17 @@ def _moved_and_still(rig, chain_top):
     return main, ~touched
 
 
-def test_window_has_one_sphere_widget_per_joint(window):
-    import vtk
-
+def test_window_draws_one_sphere_per_joint_as_one_actor(window):
     n = len(window.document.skeleton)
-    assert len(window.gizmos.widgets) == n
-    assert all(isinstance(w, vtk.vtkSphereWidget) and w.GetEnabled() for w in window.gizmos.widgets)
+    assert len(window.gizmos) == n
+    actor = window.gizmos.glyphs.actor
+    assert actor.GetVisibility() and window.overlay.HasViewProp(actor)
+    assert actor.GetMapper().GetInput().GetNumberOfPoints() == n
     heads = window.document.rig.joint_matrices(window.document.pose)[:, :3, 3]
-    centers = np.array([w.GetCenter() for w in window.gizmos.widgets])
-    np.testing.assert_allclose(centers, heads, atol=1e-6)
+    np.testing.assert_allclose(window.gizmos.positions, heads, atol=1e-6)
     assert window.info_panel.labels["Joints"].text() == str(n)
 
 
-def _fire_drag(widget, new_center):
-    widget.InvokeEvent("StartInteractionEvent")
-    widget.SetCenter(*new_center)
-    widget.InvokeEvent("InteractionEvent")
-    widget.InvokeEvent("EndInteractionEvent")
 
 
 def test_sphere_interaction_moves_subtree_vertices_only(window):
@@ -46,7 +40,7 @@ def test_sphere_interaction_moves_subtree_vertices_only(window):
     top = sk.parents[j]
     before = window.scene.mesh.points.copy()
     head = window.gizmos.center(j)
-    _fire_drag(window.gizmos.widgets[j], head + np.array([0.0, 0.0, 0.3]) * rig.height())
+    window.gizmos.drag(j, head + np.array([0.0, 0.0, 0.3]) * rig.height())
     after = window.scene.mesh.points
     moving, still = _moved_and_still(rig, top)
     assert moving.sum() > 10 and still.sum() > 10
@@ -97,7 +91,7 @@ def test_axis_constraint_keeps_drag_on_axis(window):
     root = 0
     window.set_axis(1)  # Y
     start = window.gizmos.center(root)
-    _fire_drag(window.gizmos.widgets[root], start + np.array([0.4, 0.25, -0.3]))
+    window.gizmos.drag(root, start + np.array([0.4, 0.25, -0.3]))
     moved = doc.pose.translation[root] - sk.rest_translation[root]
     np.testing.assert_allclose(moved, [0.0, 0.25, 0.0], atol=1e-9)
 
@@ -106,7 +100,7 @@ def test_root_drag_moves_whole_character(window):
     doc = window.document
     before = window.scene.mesh.points.copy()
     start = window.gizmos.center(0)
-    _fire_drag(window.gizmos.widgets[0], start + [0.1, 0.0, 0.2])
+    window.gizmos.drag(0, start + [0.1, 0.0, 0.2])
     np.testing.assert_allclose(window.scene.mesh.points - before,
                                np.tile([0.1, 0.0, 0.2], (len(before), 1)), atol=1e-4)
     assert doc.undo_stack.undo_label.startswith("Drag")
@@ -144,11 +138,11 @@ def test_tree_and_sphere_select_the_same_joint(window):
     window.joint_panel.tree.setCurrentItem(item)
     assert doc.selection == j
     assert window.gizmos.selected == j
-    sel = window.gizmos.widgets[j].GetSphereProperty().GetColor()
-    other = window.gizmos.widgets[0].GetSphereProperty().GetColor()
-    assert sel != other
-    window.gizmos.widgets[0].InvokeEvent("StartInteractionEvent")
-    window.gizmos.widgets[0].InvokeEvent("EndInteractionEvent")
+    sel = window.gizmos.glyphs.color_of(j)
+    other = window.gizmos.glyphs.color_of(_limb_joint(doc.skeleton, "fore_cannon_R"))
+    assert not np.allclose(sel, other)
+    window.gizmos.start_drag(0)
+    window.gizmos.end_drag()
     assert doc.selection == 0
     assert window.joint_panel.tree.selectedItems()[0] is window.joint_panel._items[0]
 
@@ -164,9 +158,12 @@ def test_view_modes_toggle(window):
     window.set_skeleton_visible(False)
     assert not window.scene.bone_actor.GetVisibility()
     window.set_gizmos_visible(False)
-    assert not any(w.GetEnabled() for w in window.gizmos.widgets)
+    assert not window.gizmos.glyphs.actor.GetVisibility()
+    x, y = window.gizmos.display_position(0)
+    assert window.gizmos.pick(x, y) is None  # hidden spheres are not picked
     window.set_gizmos_visible(True)
-    assert all(w.GetEnabled() for w in window.gizmos.widgets)
+    assert window.gizmos.glyphs.actor.GetVisibility()
+    assert window.gizmos.pick(x, y) is not None
     j = _limb_joint(window.document.skeleton)
     window.document.select(j)
     window.set_weights_view(True)
@@ -200,7 +197,7 @@ def test_edit_mode_drag_rebinds_in_worker_and_undoes(window, qtbot):
     window.set_mode("edit")
     start = window.gizmos.center(j)
     target = start + np.array([0.0, 0.05, 0.0]) * doc.rig.height()
-    _fire_drag(window.gizmos.widgets[j], target)
+    window.gizmos.drag(j, target)
     assert window.job is not None  # re-binding runs off the UI thread
     assert window.progress.isVisible() and window.cancel_button.isVisible()
     qtbot.waitUntil(lambda: window.job is None, timeout=30000)
@@ -247,7 +244,7 @@ def test_open_and_save_round_trip(window, qtbot, tmp_path):
     qtbot.waitUntil(lambda: window.job is None, timeout=10000)
     assert window.last_error is None
     assert window.document.rig.name == "demo creature"
-    assert len(window.gizmos.widgets) == len(window.document.skeleton) == 19
+    assert len(window.gizmos) == len(window.document.skeleton) == 19
     assert window.files.export_pose(str(tmp_path / "pose.json"))
     assert window.files.export_skeleton(str(tmp_path / "sk.json"))
     assert window.files.save_weights(str(tmp_path / "w.npz"))

@@ -96,7 +96,7 @@ class Autosave(QtCore.QObject):
     def tick(self):
         """The timer's check: write when the document changed; wait while a drag is under
         way (its intermediate pose is not an edit yet)."""
-        if self.document.dragging or getattr(self.window, "_interacting", False):
+        if self.document.dragging or getattr(self.window, "interacting", False):
             return False
         return self.save(background=True)
 

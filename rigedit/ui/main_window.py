@@ -14,15 +14,18 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 from pyvistaqt import QtInteractor
 
 from ..document import Document
-from ..render.gizmos import AxisHandles, JointGizmos, gizmo_radius, overlay_renderer
+from ..render.axis_handles import AxisHandles
+from ..render.joint_gizmos import JointGizmos, gizmo_radius
+from ..render.overlay import overlay_renderer
 from ..render.scene import RigScene
 from . import errors_hook
 from .autosave import Autosave, confirm_unsaved_changes
-from .drag import DragMixin
+from .drag import DragController, DragSettings
 from .menus import MenusMixin
 from .file_actions import FileActions
 from .joint_panel import InfoPanel, JointPanel
 from .jobs import JobsMixin
+from .rebind import RestRebind
 from .weight_brush import install_weight_brush
 from .weight_tools import install_weight_tools
 
@@ -52,7 +55,7 @@ def default_rig():
         return demo_rig(), f"bundled quadruped not available ({exc}); showing a demo creature"
 
 
-class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
+class MainWindow(MenusMixin, JobsMixin, QtWidgets.QMainWindow):
     """The rig editor.
 
     Parameters
@@ -66,13 +69,27 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
         Single source of truth: rig, pose, clips, time, selection, undo stack.
     plotter : pyvistaqt.QtInteractor
     scene : RigScene
+    overlay : vtkRenderer
+        The layer drawn over the mesh (bones, joint spheres, axis arrows).
     gizmos : JointGizmos
-        ``gizmos.widgets[j]`` is joint ``j``'s vtkSphereWidget.
+        The joint spheres (one glyph actor) and their picking; rebuilt with the scene.
+    axes : AxisHandles
+        The selected joint's X/Y/Z arrows; rebuilt with the scene.
+    drag : DragController
+        Turns gizmo drags into document edits; rebuilt with the scene.
+    drag_settings : DragSettings
+        The tool bar's constraint axis and IK chain length (kept across rigs).
+    rebind : RestRebind
+        Edit-mode rest moves re-bound in a worker; Undo cancelling a running one.
+    job : Job or None
+        The background job running now (one at a time, :class:`JobsMixin`).
     mode : {"pose", "edit"}
     axis : int or None
         Drag constraint axis (0, 1, 2) or None for free dragging.
     chain_length : int
         IK chain length of a pose-mode drag.
+    interacting : bool
+        Whether a gizmo drag is held.
     """
 
     def __init__(self, rig=None, parent=None):
@@ -82,18 +99,16 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
             rig, note = default_rig()
         self.setWindowTitle("rigedit")
         self.document = Document(rig)
-        self.axis = None
-        self.chain_length = 2
+        self.drag_settings = DragSettings()
         self.last_error = None
         self.job = None
-        self._pending_rebind = None  # (job, undo-stack top at its start, label)
         self.keep_recovery = False   # set when quitting on a signal: the entry must stay
         self.confirm_close = False   # ask about unsaved changes on close (app.py sets it)
         self._closed = False
-        self.gizmos = None
-        self.axes = None
-        self._drag = None
-        self._interacting = False
+        self.scene = self.overlay = self.gizmos = self.axes = self.drag = None  # _load_scene
+        self.rebind = RestRebind(self.document, self.run_job, lambda: self.job,
+                                 self._refresh_view, self.status, lambda: self.interacting,
+                                 self._update_undo_actions)
         self._weights_view = False
         self._build_view()
         self.files = FileActions(self)
@@ -229,16 +244,20 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
         self.scene.set_floor_visible(self.floor_action.isChecked())
         self.radius = gizmo_radius(rig)
         self.gizmos = JointGizmos(self.plotter, self.scene.joint_positions, self.radius,
-                                  self._drag_start, self._drag_move, self._drag_end,
-                                  renderer=self.overlay)
+                                  renderer=self.overlay, deform=rig.skeleton.deform)
         self.gizmos.on_error = self.report_exception
         self.gizmos.set_visible(self.gizmos_action.isChecked())
+        self.axes = AxisHandles(self.plotter, 10 * self.radius, renderer=self.overlay,
+                                gizmos=self.gizmos, interactive=True)
+        self.axes.set_axis(self.axis)
+        self.drag = DragController(self.document, self.scene, self.gizmos, self.axes,
+                                   self.drag_settings, self.rebind.move_joint, self.status,
+                                   self.request_render)
+        g, a, drag = self.gizmos, self.axes, self.drag
+        g.on_start, g.on_move, g.on_end = drag.start, drag.move, drag.end
         # The selected joint's X/Y/Z arrows are handles: a drag on one runs the same code
         # as a sphere drag, constrained to that axis.
-        self.axes = AxisHandles(self.plotter, 10 * self.radius, renderer=self.overlay,
-                                on_start=self._axis_drag_start, on_move=self._axis_drag_move,
-                                on_end=self._axis_drag_end, gizmos=self.gizmos)
-        self.axes.set_axis(self.axis)
+        a.on_start, a.on_move, a.on_end = drag.axis_start, drag.axis_move, drag.axis_end
         self.joint_panel.set_skeleton(rig.skeleton)
         self.info_panel.show_rig(rig)
         self.info_panel.show_selection(rig, None)
@@ -266,9 +285,37 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
             self.axes.set_position(heads[j])
         return model
 
+    def _refresh_view(self):
+        self._refresh_pose()
+        self.request_render()
+
+    @property
+    def interacting(self):
+        """Whether a gizmo drag is held."""
+        return self.drag is not None and self.drag.active
+
+    @property
+    def axis(self):
+        """Drag constraint axis (0, 1, 2) or None; set with :meth:`set_axis`."""
+        return self.drag_settings.axis
+
+    @property
+    def chain_length(self):
+        """IK chain length of a pose-mode drag."""
+        return self.drag_settings.chain_length
+
+    @chain_length.setter
+    def chain_length(self, n):
+        self.drag_settings.chain_length = int(n)
+
+    def undo(self):
+        """Edit > Undo: cancels a running re-bind when it is the latest edit, else undoes the
+        document's last step."""
+        return self.rebind.undo()
+
     def request_render(self):
-        """Ask Qt to repaint the view once; inside a widget drag VTK renders by itself."""
-        if not self._interacting:
+        """Ask Qt to repaint the view once; inside a gizmo drag VTK renders by itself."""
+        if not self.interacting:
             self.plotter.update()
 
     def show_pose(self, pose):
@@ -283,11 +330,12 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
             self._load_scene()
         elif event == "pose":
             self._refresh_pose()
-            if not d.dragging or not self._interacting:
+            if not d.dragging or not self.interacting:
                 self.joint_panel.show_joint(d.selection, d.pose)
             self.request_render()
         elif event == "rest":
             self.info_panel.show_rig(d.rig)
+            self.gizmos.set_deform(d.skeleton.deform)  # a deform flag may have changed
             if self._weights_view:
                 self._show_weights()
         elif event == "selection":
@@ -310,7 +358,7 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
 
     def _update_undo_actions(self):
         s = self.document.undo_stack
-        pending = self._undoable_rebind()
+        pending = self.rebind.undoable()
         if pending is not None:
             self.undo_action.setEnabled(True)  # undo cancels the running re-bind
             self.undo_action.setText(f"&Undo {pending[2]}")
@@ -382,7 +430,7 @@ class MainWindow(MenusMixin, DragMixin, JobsMixin, QtWidgets.QMainWindow):
 
     def set_axis(self, axis):
         """Constrain drags to model axis 0, 1 or 2 (X, Y, Z), or free (None)."""
-        self.axis = axis
+        self.drag_settings.axis = axis
         self.axis_actions[0 if axis is None else axis + 1].setChecked(True)
         self.axes.set_axis(axis)
         self.request_render()

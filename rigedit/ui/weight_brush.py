@@ -22,7 +22,7 @@ from PyQt5 import QtWidgets
 
 from ..model.weight_paint import (brush_vertices, joint_column, mirror_vertices, paint,
                                   paint_mirrored, vertex_adjacency)
-from ..render.gizmos import display_to_world, world_to_display
+from ..render.ray import display_to_world, world_to_display
 from .brush_panel import BrushPanel
 
 __all__ = ["BrushPanel", "WeightBrush", "install_weight_brush"]
@@ -261,13 +261,7 @@ class WeightBrush:
     def _sphere_under(self, x, y):
         """Whether a visible joint sphere is under the mouse (the spheres stay clickable)."""
         g = self.w.gizmos
-        if g is None or not g.visible or not g.widgets:
-            return False
-        origin, d = self.w.axes.ray(x, y)
-        centers = np.array([wd.GetCenter() for wd in g.widgets]) - origin
-        t = centers @ d
-        miss2 = np.einsum("ij,ij->i", centers, centers) - t * t
-        return bool(np.any((miss2 <= g.radius ** 2) & (t > 0)))
+        return g is not None and g.pick(x, y) is not None
 
     def world_radius(self, point, pixels):
         """Scene units that ``pixels`` span on screen at the depth of ``point``."""

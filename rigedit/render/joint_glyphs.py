@@ -1,0 +1,157 @@
+"""All joint spheres as one glyph actor, coloured per joint by state.
+
+One ``vtkGlyph3DMapper`` draws the same low-resolution sphere at every joint (one draw call),
+where forty ``vtkSphereWidget`` s drew forty actors of 320 triangles each. Each joint's colour
+is a direct RGB scalar on the glyph's input points, so changing a selection or a hover
+highlight rewrites a few bytes instead of swapping properties. Never imports Qt.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pyvista as pv
+import vtk
+
+__all__ = ["JointGlyphs", "SPHERE_COLOR", "SELECTED_COLOR", "ACTIVE_COLOR",
+           "NON_DEFORMING_COLOR", "hover_color"]
+
+SPHERE_COLOR = (0.55, 0.78, 1.0)
+NON_DEFORMING_COLOR = (0.60, 0.65, 0.74)  # takes no skin weight (a ground-level root)
+SELECTED_COLOR = (1.0, 0.62, 0.10)
+ACTIVE_COLOR = (1.0, 0.95, 0.35)  # while being dragged
+THETA_RESOLUTION, PHI_RESOLUTION = 14, 10  # a sphere a few pixels wide needs no more
+
+
+def hover_color(color):
+    """The hover highlight of ``color``: half way to white."""
+    c = np.asarray(color, dtype=float)
+    return tuple(c + 0.5 * (1.0 - c))
+
+
+def _rgb(color):
+    return np.round(np.asarray(color, dtype=float) * 255).astype(np.uint8)
+
+
+class JointGlyphs:
+    """Spheres of one radius at joint positions, drawn as one actor.
+
+    Parameters
+    ----------
+    positions : (J, 3) float
+    radius : float
+        Sphere radius (model units).
+    deform : (J,) bool, optional
+        Joints that take skin weight; the others are drawn in ``NON_DEFORMING_COLOR``.
+
+    Attributes
+    ----------
+    actor : vtkActor
+        Add it to a renderer.
+    points : pyvista.PolyData
+        The glyphs' centres (its ``points`` are the joint positions).
+    selected, hovered, active : int or None
+        Joints drawn highlighted (in that order of precedence, ``active`` first).
+    """
+
+    def __init__(self, positions, radius, deform=None):
+        positions = np.asarray(positions, dtype=float).reshape(-1, 3)
+        self.radius = float(radius)
+        self.points = pv.PolyData(positions.copy())
+        n = len(positions)
+        self.deform = np.ones(n, dtype=bool) if deform is None else \
+            np.asarray(deform, dtype=bool).reshape(n)
+        self.selected = self.hovered = self.active = None
+        self._colors = np.zeros((n, 3), dtype=np.uint8)
+        self.points.point_data["rgb"] = self._colors
+        # pyvista copies on assignment: write through VTK's own array from now on
+        self._colors = self.points.point_data["rgb"]
+        source = vtk.vtkSphereSource()
+        source.SetRadius(self.radius)
+        source.SetThetaResolution(THETA_RESOLUTION)
+        source.SetPhiResolution(PHI_RESOLUTION)
+        self.source = source
+        mapper = vtk.vtkGlyph3DMapper()
+        mapper.SetInputData(self.points)
+        mapper.SetSourceConnection(source.GetOutputPort())
+        mapper.ScalingOff()
+        mapper.OrientOff()
+        mapper.SetScalarModeToUsePointFieldData()
+        mapper.SelectColorArray("rgb")
+        mapper.SetColorModeToDirectScalars()
+        mapper.ScalarVisibilityOn()
+        self.mapper = mapper
+        self.actor = vtk.vtkActor()
+        self.actor.SetMapper(mapper)
+        self.actor.PickableOff()  # picked by rigedit's own ray maths, not VTK pickers
+        prop = self.actor.GetProperty()
+        prop.SetSpecular(0.4)
+        # A widget's SetColor tinted its highlight too; one colour for all glyphs keeps the
+        # spheres' look (an untinted white highlight made them visibly paler).
+        prop.SetSpecularColor(SPHERE_COLOR)
+        self._recolor()
+
+    def __len__(self):
+        return self.points.n_points
+
+    # ------------------------------------------------------------------ positions
+    @property
+    def positions(self):
+        """(J, 3) float64 view of the sphere centres (write through :meth:`set_positions`)."""
+        return self.points.points
+
+    def set_positions(self, positions, skip=None):
+        """Move every sphere (but ``skip``) onto ``positions`` (J, 3)."""
+        pts = self.points.points
+        if skip is None:
+            pts[:] = positions
+        else:
+            keep = pts[skip].copy()
+            pts[:] = positions
+            pts[skip] = keep
+        self._points_changed()
+
+    def set_center(self, j, p):
+        self.points.points[j] = np.asarray(p, dtype=float)
+        self._points_changed()
+
+    def _points_changed(self):
+        self.points.GetPoints().Modified()
+        self.points.Modified()
+
+    # ------------------------------------------------------------------ colours
+    def color_of(self, j):
+        """(3,) float RGB in [0, 1] that joint ``j`` is drawn in now."""
+        return self._colors[j] / 255.0
+
+    def set_state(self, selected=..., hovered=..., active=...):
+        """Change the highlighted joints (an argument left out keeps its value)."""
+        if selected is not ...:
+            self.selected = selected
+        if hovered is not ...:
+            self.hovered = hovered
+        if active is not ...:
+            self.active = active
+        self._recolor()
+
+    def set_deform(self, deform):
+        self.deform = np.asarray(deform, dtype=bool).reshape(len(self))
+        self._recolor()
+
+    def _recolor(self):
+        colors = np.where(self.deform[:, None], _rgb(SPHERE_COLOR), _rgb(NON_DEFORMING_COLOR))
+        if self.selected is not None:
+            colors[self.selected] = _rgb(SELECTED_COLOR)
+        if self.hovered is not None:
+            colors[self.hovered] = _rgb(hover_color(colors[self.hovered] / 255.0))
+        if self.active is not None:
+            colors[self.active] = _rgb(ACTIVE_COLOR)
+        self._colors[:] = colors
+        self.points.GetPointData().GetArray("rgb").Modified()
+        self.points.Modified()
+
+    # ------------------------------------------------------------------ visibility
+    def set_visible(self, visible):
+        self.actor.SetVisibility(bool(visible))
+
+    @property
+    def visible(self):
+        return bool(self.actor.GetVisibility())
