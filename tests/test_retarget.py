@@ -274,11 +274,13 @@ def test_bad_input_one_line(tmp_path):
     bvh.write_text(BVH_NO_LEGS)
     for argv, words in (
             (("retarget", bvh, "--to", "humanoid", "-o", tmp_path / "a.json"),
-             (str(bvh), "two legs")),
+             (str(bvh), "expected legs", "found none")),
             (("retarget", "humanoid", "--clip", "walk", "--to", bvh, "-o", tmp_path / "b.json"),
-             (str(bvh), "two legs")),
+             (str(bvh), "expected legs", "found none")),
+            # a quadruped onto a humanoid: no structure in common and no shared names
             (("retarget", "quadruped", "--clip", "walk", "--to", "humanoid", "-o",
-              tmp_path / "c.json"), ("quadruped", "not a standing humanoid")),
+              tmp_path / "c.json"), ("quadruped", "no joint maps onto the target's hips",
+                                     "--map")),
             (("retarget", "humanoid", "--to", "humanoid", "-o", tmp_path / "d.json"),
              ("humanoid", "--clip"))):
         p = _run(*argv)

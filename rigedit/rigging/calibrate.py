@@ -5,7 +5,13 @@ import numpy as np
 
 from .name_map import find_slots
 
-__all__ = ["Calibration", "calibrate", "model_stack", "swing", "unit", "rotations_of"]
+__all__ = ["Calibration", "calibrate", "model_stack", "swing", "unit", "rotations_of",
+           "foot_points", "HUMANOID_GROUPS"]
+
+#: Groups of bones reported by :func:`rigedit.rigging.measure.direction_errors` for humanoids:
+#: "feet" (foot and toe bones) apart, as their pitch is transferred relative to each figure's
+#: flat foot, not copied (see :mod:`.retarget`), so they differ by design.
+HUMANOID_GROUPS = ("arms", "legs", "spine", "head", "feet")
 
 
 def unit(v, eps=1e-12):
@@ -102,6 +108,9 @@ class Calibration:
         Height of the hips joint above the thigh joints in the pose.
     """
 
+    kind = "humanoid"
+    groups = HUMANOID_GROUPS
+
     def __init__(self, skeleton, mats, source, what):
         self.skeleton, self.mats, self.source = skeleton, mats, source
         self.points = mats[:, :3, 3]
@@ -126,35 +135,60 @@ class Calibration:
         self.hip_offset = float(p[s["hips"], 1] - np.mean([p[s["thigh_L"], 1],
                                                            p[s["thigh_R"], 1]]))
 
+    @property
+    def hips(self):
+        """The hips joint (index)."""
+        return self.slots["hips"]
+
     def foot_points(self, mats):
         """(F, P, 3) model positions of the foot and toe joints (and their tails)."""
-        sk = self.skeleton
-        pts = [mats[:, j, :3, 3] for j in self.feet]
-        for j in self.feet:
-            if np.all(np.isfinite(sk.tails[j])):
-                local = sk.inverse_bind_matrices[j] @ np.r_[sk.tails[j], 1.0]
-                pts.append((mats[:, j] @ local)[:, :3])
-        return np.stack(pts, axis=1)
+        return foot_points(self.skeleton, self.feet, mats)
+
+    def group(self, j):
+        """The measure group of joint ``j`` (one of :data:`HUMANOID_GROUPS`), or None."""
+        slot = {v: k for k, v in self.slots.items()}.get(j)
+        if slot is None:
+            return "spine" if j in self.chains["spine"] else \
+                "head" if j in self.chains["neck"] else None
+        if slot.startswith(("clavicle", "upper_arm", "forearm", "hand")):
+            return "arms"
+        if slot.startswith(("thigh", "shin")):
+            return "legs"
+        if slot.startswith(("foot", "toe")):
+            return "feet"
+        return "head" if slot in ("neck", "head") else "spine"
 
 
-def calibrate(skeleton, clips, what):
-    """The rest pose when it stands like a humanoid, else frame 0 of the first clip that does
-    (a BVH rest may lie all along one axis, as Bandai's does).
+def foot_points(skeleton, feet, mats):
+    """(F, P, 3) model positions of the joints ``feet`` and of their tails, in the poses
+    ``mats`` (F, J, 4, 4)."""
+    pts = [mats[:, j, :3, 3] for j in feet]
+    for j in feet:
+        if np.all(np.isfinite(skeleton.tails[j])):
+            local = skeleton.inverse_bind_matrices[j] @ np.r_[skeleton.tails[j], 1.0]
+            pts.append((mats[:, j] @ local)[:, :3])
+    return np.stack(pts, axis=1)
+
+
+def calibrate(skeleton, clips, what, kind=Calibration):
+    """The rest pose when it stands as ``kind`` needs (a humanoid with legs, spine and arms;
+    :class:`rigedit.rigging.limbs.LegCalibration`: legs on the floor), else frame 0 of the
+    first clip where it does (a BVH rest may lie all along one axis, as Bandai's does).
 
     Raises
     ------
     ValueError
-        Naming ``what`` and the missing part, when no pose has legs, spine and arms.
+        Naming ``what`` and the missing part, when no pose has what ``kind`` needs.
     """
     rest = skeleton.forward(skeleton.rest_local_matrices())
     try:
-        return Calibration(skeleton, rest, "rest", what)
+        return kind(skeleton, rest, "rest", what)
     except ValueError as exc:
         first = exc
     for clip in clips:
         mats = skeleton.forward(clip.sample(0.0).local_matrices())
         try:
-            return Calibration(skeleton, mats, f"frame 0 of {clip.name}", what)
+            return kind(skeleton, mats, f"frame 0 of {clip.name}", what)
         except ValueError:
             continue
     raise first

@@ -16,9 +16,10 @@ import numpy as np
 
 from scipy.spatial.transform import Rotation
 
-from .calibrate import rotations_of, swing, unit
+from .calibrate import foot_points, rotations_of, swing, unit
 
-__all__ = ["detect_contacts", "runs", "pin_offsets", "two_bone_ik", "clean_feet", "tail_point",
+__all__ = ["detect_contacts", "runs", "pin_offsets", "two_bone_ik", "clean_feet", "clean_legs",
+           "tail_point",
            "HEIGHT_TOL", "SPEED_TOL"]
 
 HEIGHT_TOL = 0.06
@@ -66,7 +67,7 @@ def detect_contacts(points, rest_heights, times, leg_length, height_tol=HEIGHT_T
     return contact
 
 
-def pin_offsets(points, contact, floor_heights, blend):
+def pin_offsets(points, contact, floor_heights, blend, heights=None):
     """Per-frame offsets that hold each contact run's point at its mean position.
 
     Parameters
@@ -78,6 +79,9 @@ def pin_offsets(points, contact, floor_heights, blend):
         No pin lower than these.
     blend : int
         Frames over which an offset fades in before a run and out after it.
+    heights : (F, P) float64, optional
+        The height each point should have in each frame of a run (the pin is then held
+        horizontally only: its mean x and z, this height); by default the run's mean height.
 
     Returns
     -------
@@ -90,16 +94,18 @@ def pin_offsets(points, contact, floor_heights, blend):
     weights = np.zeros((n, npts))
     for p in range(npts):
         for a, b in runs(contact[:, p]):
-            pin = points[a:b, p].mean(axis=0)
-            pin[1] = max(pin[1], floor_heights[p])
-            offsets[a:b, p] = pin - points[a:b, p]
+            pin = np.repeat(points[a:b, p].mean(axis=0)[None], n, axis=0)
+            if heights is not None:
+                pin[:, 1] = heights[:, p]
+            pin[:, 1] = np.maximum(pin[:, 1], floor_heights[p])
+            offsets[a:b, p] = pin[a:b] - points[a:b, p]
             weights[a:b, p] = 1.0
             for k in range(1, blend + 1):
                 w = 1.0 - k / (blend + 1)
                 for f, edge in ((a - k, a), (b - 1 + k, b - 1)):
                     if 0 <= f < n and w > weights[f, p]:
                         weights[f, p] = w
-                        offsets[f, p] = pin - points[edge, p]
+                        offsets[f, p] = pin[edge] - points[edge, p]
     return offsets, weights
 
 
@@ -155,8 +161,7 @@ def clean_feet(skeleton, tgt, rot, mats, contact, feet, times, mapped):
     rot = rot.copy()
     pts = mats[:, feet][..., :3, 3]
     rest_pts = tgt.mats[feet, :3, 3]
-    dt = float(np.median(np.diff(times))) if len(times) > 1 else 1 / 30
-    blend = max(2, int(round(0.1 / dt)))
+    blend = _blend_frames(times)
     offsets, weights = pin_offsets(pts, contact, rest_pts[:, 1], blend)
     goals = {}
     for side, (ankle_i, toe_i) in (("L", (0, 2)), ("R", (1, 3))):
@@ -186,14 +191,65 @@ def clean_feet(skeleton, tgt, rot, mats, contact, feet, times, mapped):
         lift = np.max(np.maximum(0.0, np.array(rest_low)[None] - np.stack(low, axis=1)), axis=1)
         goal[:, 1] += lift
         goals[side] = (ankle, goal)
-    # Where a stretched leg cannot reach its goal, lower the hips by the shortfall (spread
-    # over the blend window so the body does not jolt).
-    drop = np.zeros(len(times))
-    for side, (ankle, goal) in goals.items():
-        th, sh = tgt.slots[f"thigh_{side}"], tgt.slots[f"shin_{side}"]
-        hip = mats[:, th, :3, 3]
-        reach = 0.999 * (np.linalg.norm(mats[:, sh, :3, 3] - hip, axis=1)
-                         + np.linalg.norm(ankle - mats[:, sh, :3, 3], axis=1))
+    legs = [(tgt.slots[f"thigh_{side}"], tgt.slots[f"shin_{side}"], ankle, goal)
+            for side, (ankle, goal) in goals.items()]
+    return _solve_legs(skeleton, tgt, rot, mats, legs, blend, mapped)
+
+
+def clean_legs(skeleton, tgt, rot, mats, contact, legs, times, mapped, heights=None):
+    """:func:`clean_feet` for any number of legs found by structure
+    (:class:`rigedit.rigging.limbs.LegCalibration`): each leg's contact (its foot leaf) is
+    held at its mean position by moving the ankle, the foot part moving rigidly with it; no
+    point of the foot part goes below the floor (``tgt.floor``); the hips drop where a stretched leg
+    falls short; each leg is solved by two-bone IK (upper joint and knee).
+
+    Parameters
+    ----------
+    contact : (F, len(legs)) bool
+        Contact of each leg's foot leaf.
+    legs : list of Leg
+    heights : (F, len(legs)) float64, optional
+        Height of each foot leaf during its contacts (the source's, scaled: a fetlock that
+        sinks under the weight keeps doing so); by default each contact's mean height.
+
+    Returns
+    -------
+    rot : (F, J, 3, 3) float64
+    drop : (F,) float64
+    """
+    rot = rot.copy()
+    pts = mats[:, [leg.contact for leg in legs]][..., :3, 3]
+    blend = _blend_frames(times)
+    # the floor, not each point's rest height: a hoof's fetlock sinks while its tip stands
+    offsets, weights = pin_offsets(pts, contact, np.full(len(legs), tgt.floor), blend,
+                                   heights)
+    solve = []
+    for i, leg in enumerate(legs):
+        ankle = mats[:, leg.ankle, :3, 3]
+        goal = ankle + weights[:, i, None] * offsets[:, i]
+        # the foot part moves with the ankle: none of its points below the floor
+        below = foot_points(skeleton, leg.foot, mats)[..., 1] - ankle[:, 1:2]
+        goal[:, 1] += np.maximum(0.0, tgt.floor - below.min(axis=1) - goal[:, 1])
+        solve.append((leg.upper, leg.knee, ankle, goal))
+    return _solve_legs(skeleton, tgt, rot, mats, solve, blend, mapped)
+
+
+def _blend_frames(times):
+    dt = float(np.median(np.diff(times))) if len(times) > 1 else 1 / 30
+    return max(2, int(round(0.1 / dt)))
+
+
+def _solve_legs(skeleton, tgt, rot, mats, legs, blend, mapped):
+    """Lower the hips where a stretched leg cannot reach its goal (by the shortfall, spread
+    over the blend window so the body does not jolt), then solve each leg ``(upper, knee,
+    ankle (F, 3), goal (F, 3))`` by two-bone IK; joints the map leaves out below the upper
+    joints keep their rest pose below the turned ones. Returns ``rot``, ``drop``."""
+    n = len(rot)
+    drop = np.zeros(n)
+    for upper, knee, ankle, goal in legs:
+        hip = mats[:, upper, :3, 3]
+        reach = 0.999 * (np.linalg.norm(mats[:, knee, :3, 3] - hip, axis=1)
+                         + np.linalg.norm(ankle - mats[:, knee, :3, 3], axis=1))
         v = goal - hip
         horiz = np.linalg.norm(v[:, [0, 2]], axis=1)
         # hip height above the goal at which the goal is just in reach
@@ -201,18 +257,16 @@ def clean_feet(skeleton, tgt, rot, mats, contact, feet, times, mapped):
         drop = np.maximum(drop, np.maximum(0.0, -v[:, 1] - ok_height))
     if drop.any():
         drop = _smooth_max(drop, blend)
-    hips_rot = rot[:, tgt.slots["hips"]]
-    normal = hips_rot @ (rotations_of(tgt.mats)[tgt.slots["hips"]].T @ tgt.left)
-    for side, (ankle, goal) in goals.items():
-        th, sh = tgt.slots[f"thigh_{side}"], tgt.slots[f"shin_{side}"]
-        down = np.c_[np.zeros(len(times)), drop, np.zeros(len(times))]
-        rot[:, th], rot[:, sh] = two_bone_ik(
-            mats[:, th, :3, 3] - down, mats[:, sh, :3, 3] - down, ankle - down, goal,
-            rot[:, th], rot[:, sh], normal)
-    # joints the map leaves out in the legs keep their rest pose below the turned ones
+    hips_rot = rot[:, tgt.hips]
+    normal = hips_rot @ (rotations_of(tgt.mats)[tgt.hips].T @ tgt.left)
+    down = np.c_[np.zeros(n), drop, np.zeros(n)]
+    for upper, knee, ankle, goal in legs:
+        rot[:, upper], rot[:, knee] = two_bone_ik(
+            mats[:, upper, :3, 3] - down, mats[:, knee, :3, 3] - down, ankle - down, goal,
+            rot[:, upper], rot[:, knee], normal)
     rest_rot = Rotation.from_quat(skeleton.rest_rotation).as_matrix()
-    for side in "LR":
-        for j in skeleton.subtree(tgt.slots[f"thigh_{side}"])[1:]:
+    for upper, *_ in legs:
+        for j in skeleton.subtree(upper)[1:]:
             if j not in mapped:
                 rot[:, j] = rot[:, skeleton.parents[j]] @ rest_rot[j]
     return rot, drop

@@ -6,30 +6,14 @@ import numpy as np
 from .contacts import runs
 
 __all__ = ["direction_errors", "foot_slip", "lowest_foot", "target_foot_points",
-           "source_foot_points", "GROUPS"]
-
-#: "feet" (foot and toe bones) are reported apart: their pitch is transferred relative to each
-#: figure's flat foot, not copied (see :mod:`.retarget`), so they differ by design.
-GROUPS = ("arms", "legs", "spine", "head", "feet")
-
-
-def _group(slot):
-    if slot is None:
-        return None
-    if slot.startswith(("clavicle", "upper_arm", "forearm", "hand")):
-        return "arms"
-    if slot.startswith(("thigh", "shin")):
-        return "legs"
-    if slot.startswith(("foot", "toe")):
-        return "feet"
-    if slot in ("neck", "head"):
-        return "head"
-    return "spine"
+           "source_foot_points"]
 
 
 def direction_errors(result, mats=None):
     """Mean angle (degrees) between each mapped target bone and its source bone, in model
-    space, over all frames, per group (arms, legs, spine, head, feet).
+    space, over all frames, per group of the target calibration (humanoids: arms, legs,
+    spine, head, feet, the feet's pitch being relative to each flat foot by design; other
+    skeletons: legs, spine, head (neck and head), tail).
 
     Parameters
     ----------
@@ -40,19 +24,16 @@ def direction_errors(result, mats=None):
     Returns
     -------
     errors : dict[str, float]
-        Group -> mean angle; ``"worst"`` -> the largest single-frame angle outside the feet.
+        Group -> mean angle (NaN for a group without bones); ``"worst"`` -> the largest
+        single-frame angle outside the feet.
     """
     from .retarget import _end_points
 
     mats = result.mats if mats is None else mats
     tgt = result.target_calibration
-    slot_of = {j: k for k, j in tgt.slots.items()}
-    spine = set(tgt.chains["spine"])
-    neck = set(tgt.chains["neck"])
-    per, worst = {g: [] for g in GROUPS}, 0.0
+    per, worst = {g: [] for g in tgt.groups}, 0.0
     for j, t_spec, s, s_spec in result.pairs:
-        g = _group(slot_of.get(j)) or ("spine" if j in spine else "head" if j in neck
-                                       else None)
+        g = tgt.group(j)
         if g is None:
             continue
         vt = _end_points(mats, t_spec) - mats[:, j, :3, 3]
@@ -97,11 +78,13 @@ def lowest_foot(result, mats=None):
 
 
 def target_foot_points(result, mats=None):
-    """(F, 4, 3) target left/right ankle and toe joints (the contact points)."""
+    """(F, P, 3) target contact points (humanoids: left/right ankle and toe joints; others:
+    each leg's foot leaf), the columns of ``result.contact``."""
     mats = result.mats if mats is None else mats
-    return mats[:, result.target_calibration.contacts][..., :3, 3]
+    return mats[:, result.target_contacts][..., :3, 3]
 
 
 def source_foot_points(result):
-    """(F, 4, 3) source left/right ankle and toe joints after the facing turn."""
-    return result.source_mats[:, result.source_calibration.contacts][..., :3, 3]
+    """(F, P, 3) the source's contact points matching :func:`target_foot_points`, after the
+    facing turn."""
+    return result.source_mats[:, result.source_contacts][..., :3, 3]

@@ -21,8 +21,8 @@ import numpy as np
 
 from ..errors import RigFileError
 
-__all__ = ["normalise_name", "find_slots", "auto_map", "load_map", "save_map",
-           "LIMB_SLOTS"]
+__all__ = ["normalise_name", "find_slots", "auto_map", "name_pairs", "load_map", "save_map",
+           "bend_index", "LIMB_SLOTS"]
 
 LIMB_SLOTS = ("clavicle", "upper_arm", "forearm", "hand", "thigh", "shin", "foot", "toe")
 _NOISE = {"joint", "jnt", "bone", "skeleton", "def", "bip01", "bip001", "mixamorig", "end", "j",
@@ -98,7 +98,7 @@ def _chain(skeleton, start, score):
         chain.append(int(kids[np.argmax(score[kids])]))
 
 
-def _bend_index(skeleton, chain, points, keywords):
+def bend_index(skeleton, chain, points, keywords):
     """Index in ``chain`` of the knee or elbow: the one joint named so, else the joint between
     the two longest consecutive segments (it needs a joint on each side)."""
     named = [i for i, j in enumerate(chain) if normalise_name(skeleton.names[j])[1] in keywords]
@@ -196,7 +196,7 @@ def find_slots(skeleton, points, what="skeleton"):
     limbs = {}
     fwd = np.zeros(3)
     for ch in leg_chains:
-        k = _bend_index(skeleton, ch, points, _KNEE)
+        k = bend_index(skeleton, ch, points, _KNEE)
         if k is None or k + 1 >= len(ch):
             raise ValueError(f"{what}: expected a leg of hip, knee and ankle, got the chain "
                              f"{[skeleton.names[j] for j in ch]}")
@@ -208,7 +208,7 @@ def find_slots(skeleton, points, what="skeleton"):
         limbs[ch[0]] = part
     for c in arms:
         ch = _chain(skeleton, c, reach)
-        k = _bend_index(skeleton, ch, points, _ELBOW)
+        k = bend_index(skeleton, ch, points, _ELBOW)
         if k is None:
             raise ValueError(f"{what}: expected an arm of shoulder, elbow and wrist, got the "
                              f"chain {[skeleton.names[j] for j in ch]}")
@@ -282,17 +282,47 @@ def auto_map(src_skeleton, src_points, tgt_skeleton, tgt_points, src_what="sourc
     pairs = [(s_slots[k], t_slots[k]) for k in t_slots if k in s_slots]
     for name in ("spine", "neck"):
         pairs += _interior_map(s_chains[name], src_points, t_chains[name], tgt_points)
-    s_used = {a for a, _ in pairs}
-    t_used = {b for _, b in pairs}
-    by_name = {}
-    for j, nm in enumerate(tgt_skeleton.names):
-        if j not in t_used:
-            by_name.setdefault(normalise_name(nm), []).append(j)
-    for j, nm in enumerate(src_skeleton.names):
-        cand = by_name.get(normalise_name(nm), [])
-        if j not in s_used and len(cand) == 1 and normalise_name(nm)[1]:
-            pairs.append((j, cand[0]))
-    return {src_skeleton.names[a]: tgt_skeleton.names[b] for a, b in pairs}
+    mapping = {src_skeleton.names[a]: tgt_skeleton.names[b] for a, b in pairs}
+    mapping.update(name_pairs(src_skeleton, tgt_skeleton, mapping))
+    return mapping
+
+
+def name_pairs(src_skeleton, tgt_skeleton, taken=None):
+    """Joints paired by name: equal names first, then equal normalised names (side and base
+    word, :func:`normalise_name`) where exactly one joint on each side has it.
+
+    Parameters
+    ----------
+    src_skeleton, tgt_skeleton : Skeleton
+    taken : dict[str, str], optional
+        Pairs already made (source -> target); their joints are left out.
+
+    Returns
+    -------
+    mapping : dict[str, str]
+        The new pairs, source joint name -> target joint name.
+    """
+    taken = dict(taken or {})
+    s_used, t_used = set(taken), set(taken.values())
+    out = {}
+    for nm in src_skeleton.names:
+        if nm not in s_used and nm in tgt_skeleton.index and nm not in t_used:
+            out[nm] = nm
+    s_used |= set(out)
+    t_used |= set(out.values())
+
+    def keyed(names, used):
+        keys = {}
+        for nm in names:
+            if nm not in used:
+                keys.setdefault(normalise_name(nm), []).append(nm)
+        return keys
+
+    s_keys = keyed(src_skeleton.names, s_used)
+    for key, cand in keyed(tgt_skeleton.names, t_used).items():
+        if key[1] and len(cand) == 1 and len(s_keys.get(key, [])) == 1:
+            out[s_keys[key][0]] = cand[0]
+    return out
 
 
 def load_map(path, src_skeleton=None, tgt_skeleton=None):

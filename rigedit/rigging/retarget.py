@@ -1,4 +1,11 @@
-"""Retarget a clip from one humanoid skeleton onto another.
+"""Retarget a clip from one skeleton onto another: two humanoids, two quadrupeds, or any
+two skeletons with legs and a joint map.
+
+Two humanoids are calibrated by their slots (:mod:`.name_map`: legs, spine, arms found by
+structure, so CMU, Bandai, Mixamo and glTF names map automatically); any other pair by its
+legs (:mod:`.limbs`: leaf chains that reach the floor in a standing pose), mapped by equal
+joint names (an auto-rigged character keeps its template's names, so the map is the
+identity) or by a given map.
 
 Each mapped target bone is made to point, in model space, the way its source bone points
 (from the joint to its next mapped joint, or to its tail), frame by frame; local Euler angles
@@ -11,13 +18,13 @@ body forward and left as close as they go), the target joint's model rotation is
 bone direction exact in that frame (it differs from identity where unmapped source joints
 between two mapped ones bend). When both rests stand alike, ``X`` is the identity and this is
 ``S(t) · S_c⁻¹ · T_c``. The source is first turned about the vertical axis by the multiple of
-90 degrees that brings its facing (heel to toe) onto the target's.
+90 degrees that brings its facing (heel to toe; hind feet to fore feet) onto the target's.
 
 The hips follow the source's hips scaled by the ratio of hip heights (target / source, each
-the height of the thigh joints standing straight: the leg length), both horizontally and
-vertically, above the target's floor (its lowest foot joint at rest); vertically it is the
-thigh joints that are placed, so a deeper pelvis does not shorten the legs' reach. Then the feet are cleaned up
-(:mod:`.contacts`).
+the height of the thigh joints standing straight: the leg length; for a quadruped its hind
+legs'), both horizontally and vertically, above the target's floor (its lowest foot joint at
+rest); vertically it is the thigh joints that are placed, so a deeper pelvis does not
+shorten the legs' reach. Then the feet are cleaned up (:mod:`.contacts`).
 """
 from __future__ import annotations
 
@@ -26,11 +33,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..animation.clip import Clip, Track
-from .calibrate import calibrate, model_stack, rotations_of, swing, unit
+from ..animation.clip import Clip
+from .bake import assemble, to_clip
+from .calibrate import calibrate, foot_points, model_stack, rotations_of, swing, unit
 from .chains import distribute_bend
-from .contacts import clean_feet as hold_feet, detect_contacts
-from .name_map import auto_map
+from .contacts import clean_feet as hold_feet, clean_legs, detect_contacts
+from .limbs import LegCalibration
+from .name_map import auto_map, name_pairs
 
 __all__ = ["retarget", "retarget_result", "RetargetResult"]
 
@@ -54,9 +63,15 @@ class RetargetResult:
         Source model matrices after the facing turn.
     raw_mats, mats : (F, Jt, 4, 4) float64
         Target model matrices before and after the foot clean-up.
-    contact : (F, 4) bool
-        Source contacts of the left ankle, right ankle, left toe, right toe.
+    contact : (F, P) bool
+        Source contacts: for humanoids of the left ankle, right ankle, left toe, right toe;
+        otherwise of the source foot under each target leg (in the target's leg order).
     source_floor : float
+    pairs : list
+        ``(target joint, end, source joint, source end)`` of each bone pointed like its
+        source bone.
+    source_contacts, target_contacts : list of int
+        The source and target joints of the contact points (the columns of ``contact``).
     """
 
     clip: Clip
@@ -72,6 +87,8 @@ class RetargetResult:
     contact: np.ndarray
     source_floor: float
     pairs: list = field(default_factory=list)
+    source_contacts: list = field(default_factory=list)
+    target_contacts: list = field(default_factory=list)
 
 
 def _sample_times(clip):
@@ -125,7 +142,8 @@ def _facing(src, tgt):
 
 
 def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_feet=True):
-    """Retarget ``source_clip`` of ``source_rig`` onto ``target_rig``.
+    """Retarget ``source_clip`` of ``source_rig`` onto ``target_rig`` (two humanoids, or
+    any two skeletons with legs on the floor whose joints share names or are mapped).
 
     Parameters
     ----------
@@ -133,7 +151,8 @@ def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_fee
     source_clip : Clip or str
         A clip of the source (or its name).
     map : dict[str, str], optional
-        Source joint -> target joint; found automatically (:func:`auto_map`) when omitted.
+        Source joint -> target joint; found automatically when omitted (:func:`auto_map`
+        for two humanoids, else :func:`name_pairs`: equal names).
     name : str, optional
         The new clip's name (the source clip's by default).
     clean_feet : bool
@@ -147,7 +166,8 @@ def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_fee
     Raises
     ------
     ValueError
-        When either skeleton has no humanoid legs, spine and arms, or the map is empty.
+        Naming the file: when either skeleton has no legs on the floor, when the map names
+        unknown joints, is empty or leaves the target's hips (a humanoid's legs) unmapped.
     """
     return retarget_result(source_rig, source_clip, target_rig, map, name, clean_feet).clip
 
@@ -159,43 +179,172 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
     if isinstance(source_clip, str):
         source_clip = source_rig.clips[source_clip]
     ssk, tsk = source_rig.skeleton, target_rig.skeleton
-    src = calibrate(ssk, [source_clip], source_what)
-    tgt = calibrate(tsk, list(target_rig.clips.values()), target_what)
+    src, tgt = _calibrate_pair(ssk, [source_clip], tsk, list(target_rig.clips.values()),
+                               source_what, target_what)
+    humanoid = src.kind == "humanoid"
     if map is None:
-        map = auto_map(ssk, src.points, tsk, tgt.points, source_what, target_what)
-    if not map:
-        raise ValueError(f"{source_what}: no joint maps onto {target_what}")
-    inverse = {tsk.index[t]: ssk.index[s] for s, t in map.items()}
-    for slot in ("hips", "thigh_L", "shin_L", "foot_L", "thigh_R", "shin_R", "foot_R"):
-        if tgt.slots[slot] not in inverse:
-            raise ValueError(f"{source_what}: no joint maps onto the target's {slot} "
-                             f"({tsk.names[tgt.slots[slot]]})")
+        map = auto_map(ssk, src.points, tsk, tgt.points, source_what, target_what) \
+            if humanoid else name_pairs(ssk, tsk)
+    inverse = _inverse_map(map, src, tgt, source_what, target_what)
     facing, rf = _facing(src, tgt)
     times = _sample_times(source_clip)
-    smats = model_stack(ssk, source_clip, times)
     turn = np.eye(4)
     turn[:3, :3] = rf
-    smats = turn @ smats
+    smats = turn @ model_stack(ssk, source_clip, times)
     scal = turn @ src.mats
+    s_feet = smats[:, src.contacts][..., :3, 3]
+    # the motion's own floor: a low percentile of the lowest foot point per frame
+    s_floor = float(np.percentile(s_feet[..., 1].min(axis=1), 5)) if len(times) > 1 \
+        else src.floor
+    rest_h = scal[src.contacts, 1, 3] - src.joint_floor
+    contact = detect_contacts(s_feet - [0, s_floor, 0], rest_h, times, src.hip_height)
+    s_points = src.contacts
+    if not humanoid:
+        contact, s_points, s_legs = _leg_contacts(src, tgt, inverse, contact)
+    rot, pairs = _transfer(src, tgt, inverse, smats, scal, rf, contact if humanoid else None)
+    scale = tgt.hip_height / src.hip_height
+    hips = tgt.hips
+    hips_s = smats[:, inverse[hips], :3, 3]
+    if humanoid:
+        hips_t = hips_s * scale
+    else:  # relative to each rest: a quadruped's pelvis stands far from the origin
+        hips_t = tgt.points[hips] + (hips_s - scal[inverse[hips], :3, 3]) * scale
+    # the thigh joints go where the source's go, scaled: the pelvis depth is each one's own
+    hips_t[:, 1] = tgt.joint_floor + (hips_s[:, 1] - s_floor - src.hip_offset) * scale \
+        + tgt.hip_offset
+    raw = assemble(tsk, rot, hips, hips_t)
+    if not humanoid:
+        shift, heights = _ground(src, tgt, smats, raw, s_legs, scale)
+        hips_t[:, 1] += shift
+        raw = assemble(tsk, rot, hips, hips_t)
+        heights += shift
+    mats = raw
+    if clean_feet:
+        if humanoid:
+            rot, drop = hold_feet(tsk, tgt, rot, raw, contact, tgt.contacts, times, inverse)
+        else:
+            rot, drop = clean_legs(tsk, tgt, rot, raw, contact, tgt.legs, times, inverse,
+                                   heights)
+        hips_t = hips_t - np.c_[np.zeros_like(drop), drop, np.zeros_like(drop)]
+        mats = assemble(tsk, rot, hips, hips_t)
+    clip = to_clip(tsk, mats, rot, times, name or source_clip.name, source_clip, hips,
+                   tgt.points[hips])
+    return RetargetResult(clip, dict(map), src, tgt, facing, scale, times, smats, raw, mats,
+                          contact, s_floor, pairs, list(s_points), list(tgt.contacts))
+
+
+def _calibrate_pair(ssk, s_clips, tsk, t_clips, s_what, t_what):
+    """Both skeletons as humanoids (slots, :class:`Calibration`) when both stand like one;
+    otherwise both by their legs (:class:`LegCalibration`: any skeleton with feet)."""
+    try:
+        return calibrate(ssk, s_clips, s_what), calibrate(tsk, t_clips, t_what)
+    except ValueError:
+        pass
+    return (calibrate(ssk, s_clips, s_what, LegCalibration),
+            calibrate(tsk, t_clips, t_what, LegCalibration))
+
+
+def _inverse_map(mapping, src, tgt, source_what, target_what):
+    """Target joint index -> source joint index, after checking the map's names and that it
+    reaches what the retarget needs (the hips; a humanoid's legs)."""
+    ssk, tsk = src.skeleton, tgt.skeleton
+    for names, sk, role, what in ((mapping.keys(), ssk, "source", source_what),
+                                  (mapping.values(), tsk, "target", target_what)):
+        unknown = [nm for nm in names if nm not in sk.index]
+        if unknown:
+            raise ValueError(f"{what}: the joint map names {role} joints it does not have: "
+                             f"{', '.join(repr(nm) for nm in unknown[:5])}")
+    if len(set(mapping.values())) != len(mapping):
+        raise ValueError(f"{target_what}: the joint map names a target joint twice")
+    if not mapping:
+        raise ValueError(f"{source_what}: none of its {len(ssk)} joints maps onto "
+                         f"{target_what}: they are not two humanoids (matched by structure) "
+                         f"and share no joint names; give a joint map (--map)")
+    inverse = {tsk.index[t]: ssk.index[s] for s, t in mapping.items()}
+    need = ("hips",) if tgt.kind != "humanoid" else \
+        ("hips", "thigh_L", "shin_L", "foot_L", "thigh_R", "shin_R", "foot_R")
+    for slot in need:
+        j = tgt.hips if slot == "hips" else tgt.slots[slot]
+        if j not in inverse:
+            raise ValueError(f"{source_what}: no joint maps onto the target's {slot} "
+                             f"({tsk.names[j]}) in {target_what}" +
+                             ("" if tgt.kind == "humanoid" else
+                              f" ({len(mapping)} joint names in common); give a joint map "
+                              f"(--map)"))
+    return inverse
+
+
+def _leg_contacts(src, tgt, inverse, contact):
+    """Each target leg's contact mask, from the source leg its lowest mapped joint lies in.
+
+    Returns
+    -------
+    contact : (F, len(tgt.legs)) bool
+        All False for a leg no source leg maps onto (it is still kept above the floor).
+    source_points : list of int
+        The source foot leaf per target leg (the first source leaf for an unmatched leg,
+        which never touches in ``contact``).
+    source_legs : list of int or None
+        The index of the source leg per target leg.
+    """
+    out = np.zeros((len(contact), len(tgt.legs)), dtype=bool)
+    points = [src.contacts[0]] * len(tgt.legs)
+    legs = [None] * len(tgt.legs)
+    for i, leg in enumerate(tgt.legs):
+        mapped = [inverse[j] for j in reversed(leg.chain) if j in inverse]
+        for k, s_leg in enumerate(src.legs):
+            if mapped and mapped[0] in s_leg.chain:
+                out[:, i], points[i], legs[i] = contact[:, k], s_leg.contact, k
+                break
+    return out, points, legs
+
+
+def _ground(src, tgt, smats, raw, s_legs, scale):
+    """Where the target's feet stand: the vertical shift that puts its lowest foot point on
+    its floor as often as the source's stands on the source's ground (both: the 5th
+    percentile over the frames of the lowest foot point, so that a rest with other foot
+    angles does not sink or lift the motion), and the height of each target foot leaf during
+    contacts, before the shift: its foot's lowest point as high above the floor as the
+    source foot's, scaled, the leaf above that point as the foot's turn puts it.
+
+    Returns
+    -------
+    shift : float
+    heights : (F, len(tgt.legs)) float64
+    """
+    s_ground = np.percentile(src.foot_points(smats)[..., 1].min(axis=1), 5)
+    shift = tgt.floor - np.percentile(tgt.foot_points(raw)[..., 1].min(axis=1), 5)
+    heights = raw[:, tgt.contacts, 1, 3].copy()
+    for i, (leg, k) in enumerate(zip(tgt.legs, s_legs)):
+        if k is None:
+            continue
+        t_low = foot_points(tgt.skeleton, leg.foot, raw)[..., 1].min(axis=1)
+        s_low = foot_points(src.skeleton, src.legs[k].foot, smats)[..., 1].min(axis=1)
+        heights[:, i] += tgt.floor - shift + scale * (s_low - s_ground) - t_low
+    return shift, heights
+
+
+def _transfer(src, tgt, inverse, smats, scal, rf, contact):
+    """Model rotations (F, Jt, 3, 3) of the target pointing each mapped bone where its
+    source bone points (see the module docstring), and the measured pairs
+    ``(joint, end spec, source joint, source end spec)``. ``contact`` (humanoids): the
+    source contacts, for the feet's pitch relative to the flat foot."""
+    ssk, tsk = src.skeleton, tgt.skeleton
     s_rot, sc_rot = rotations_of(smats), rotations_of(scal)
     t_rot_c = rotations_of(tgt.mats)
     s_fwd, s_left = rf @ src.forward, rf @ src.left
+    humanoid = tgt.kind == "humanoid"
     # chain order (spine then neck) decides a chest's "next" joint: the neck, not an arm
-    chain = [j for j in tgt.chains["spine"] + tgt.chains["neck"] if j in inverse]
-    n_frames, nj = len(times), len(tsk)
+    chain = [j for j in tgt.chains["spine"] + tgt.chains["neck"] if j in inverse] \
+        if humanoid else []
+    n_frames, nj = len(smats), len(tsk)
     rot = np.empty((n_frames, nj, 3, 3))
     rest_rot = Rotation.from_quat(tsk.rest_rotation).as_matrix()
-    src_feet = src.contacts
-    s_feet = smats[:, src_feet][..., :3, 3]
-    # the motion's own floor: a low percentile of the lowest foot point per frame
-    s_floor = float(np.percentile(s_feet[..., 1].min(axis=1), 5)) if n_frames > 1 else src.floor
-    rest_h = scal[src_feet, 1, 3] - src.joint_floor
-    contact = detect_contacts(s_feet - [0, s_floor, 0], rest_h, times, src.hip_height)
     # feet and toes: pitch relative to each figure's flat foot, not the same direction (a
     # BVH foot often points more steeply down than a mesh's: copied, the toes would dig in)
     flat = {tgt.slots[f"{part}_{side}"]: contact[:, k] & contact[:, k + 2]
             for k, side in enumerate("LR") for part in ("foot", "toe")
-            if f"{part}_{side}" in tgt.slots}
+            if f"{part}_{side}" in tgt.slots} if humanoid else {}
     pairs = []
     for j in range(nj):
         p = tsk.parents[j]
@@ -204,7 +353,7 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
             continue
         s = inverse[j]
         nxt = chain[chain.index(j) + 1] if j in chain and j != chain[-1] else None
-        if j == tgt.slots["hips"]:
+        if humanoid and j == tgt.hips:
             nxt = tgt.slots["chest"]
         t_spec = _end_spec(tsk, tgt, j, inverse, nxt)
         s_spec = None
@@ -217,17 +366,16 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
         if s_spec is not None:
             vt = _end_points(tgt.mats, t_spec) - tgt.points[j]
             vs = _end_points(scal, s_spec) - scal[s, :3, 3]
-            size = tgt.hip_height
-            if np.linalg.norm(vt) < 1e-4 * size or np.linalg.norm(vs) < 1e-4 * src.hip_height:
+            if np.linalg.norm(vt) < 1e-4 * tgt.hip_height or \
+                    np.linalg.norm(vs) < 1e-4 * src.hip_height:
                 vt = vs = None
         if vt is not None:
             x, _ = Rotation.align_vectors([vs, s_fwd, s_left], [vt, tgt.forward, tgt.left],
                                           weights=[np.inf, 1.0, 1.0])
         else:
             x, _ = Rotation.align_vectors([s_fwd, s_left], [tgt.forward, tgt.left])
-        a = sc_rot[s].T @ x.as_matrix() @ t_rot_c[j]
-        r = s_rot[:, s] @ a
-        if vt is not None and j != tgt.slots["hips"]:
+        r = s_rot[:, s] @ (sc_rot[s].T @ x.as_matrix() @ t_rot_c[j])
+        if vt is not None and j != tgt.hips:
             u = t_rot_c[j].T @ vt
             want = _end_points(smats, s_spec) - smats[:, s, :3, 3]
             if j in flat:
@@ -236,24 +384,9 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
             r = swing(r @ u, want) @ r
             pairs.append((j, t_spec, s, s_spec))
         rot[:, j] = r
-    distribute_bend(tsk, tgt, rot, inverse)
-    scale = tgt.hip_height / src.hip_height
-    hips_s = smats[:, inverse[tgt.slots["hips"]], :3, 3]
-    hips_t = hips_s * scale
-    # the thigh joints go where the source's go, scaled: the pelvis depth is each one's own
-    hips_t[:, 1] = tgt.joint_floor + (hips_s[:, 1] - s_floor - src.hip_offset) * scale \
-        + tgt.hip_offset
-    raw = _assemble(tsk, rot, tgt.slots["hips"], hips_t)
-    tgt_feet = tgt.contacts
-    mats = raw
-    if clean_feet:
-        rot, drop = hold_feet(tsk, tgt, rot, raw, contact, tgt_feet, times, inverse)
-        hips_t = hips_t - np.c_[np.zeros_like(drop), drop, np.zeros_like(drop)]
-        mats = _assemble(tsk, rot, tgt.slots["hips"], hips_t)
-    clip = _to_clip(tsk, mats, rot, times, name or source_clip.name, source_clip,
-                    tgt.slots["hips"], tgt.points[tgt.slots["hips"]])
-    return RetargetResult(clip, dict(map), src, tgt, facing, scale, times, smats, raw, mats,
-                          contact, s_floor, pairs)
+    if humanoid:
+        distribute_bend(tsk, tgt, rot, inverse)
+    return rot, pairs
 
 
 def _pitch(v):
@@ -267,56 +400,3 @@ def _pitched(v, delta):
     axis = unit(np.cross(v, [0.0, 1.0, 0.0]))
     rv = Rotation.from_rotvec(axis * delta)
     return rv.apply(v)
-
-
-def _assemble(skeleton, rot, hips, hips_pos):
-    """Model matrices from model rotations, rest translations and the hips' model position.
-
-    Returns
-    -------
-    mats : (F, J, 4, 4) float64
-    """
-    n_frames, nj = rot.shape[:2]
-    mats = np.zeros((n_frames, nj, 4, 4))
-    mats[..., 3, 3] = 1.0
-    for j in range(nj):
-        p = skeleton.parents[j]
-        mats[:, j, :3, :3] = rot[:, j] * skeleton.rest_scale[j]
-        if j == hips:
-            mats[:, j, :3, 3] = hips_pos
-        elif p >= 0:
-            mats[:, j, :3, 3] = (mats[:, p] @ np.r_[skeleton.rest_translation[j], 1.0])[:, :3]
-        else:
-            mats[:, j, :3, 3] = skeleton.rest_translation[j]
-    return mats
-
-
-def _to_clip(skeleton, mats, rot, times, name, source_clip, hips, hips_rest):
-    """Local keys from model matrices: a rotation track per joint whose rotation moves, a
-    translation track for the hips; when the hips hang from a non-deforming root (a
-    ground-level carrier, as the bundled characters have), the root carries the horizontal
-    travel, as in the bundled walks (the recorder's camera follows it)."""
-    tracks = {}
-    nj = len(skeleton)
-    for j in range(nj):
-        p = skeleton.parents[j]
-        local = rot[:, j] if p < 0 else np.swapaxes(rot[:, p], -1, -2) @ rot[:, j]
-        quats = Rotation.from_matrix(local).as_quat()
-        if np.allclose(np.abs(quats @ skeleton.rest_rotation[j]), 1.0, atol=1e-9):
-            continue
-        tracks[(skeleton.names[j], "rotation")] = Track("rotation", times, quats, "slerp")
-    p = skeleton.parents[hips]
-    world = np.c_[mats[:, hips, :3, 3], np.ones(len(times))]
-    if p >= 0 and skeleton.parents[p] < 0 and not skeleton.deform[p]:
-        travel = (world[:, :3] - hips_rest) * [1.0, 0.0, 1.0]
-        carried = skeleton.rest_translation[p] + travel
-        mats = mats.copy()
-        mats[:, p, :3, 3] = carried
-        tracks[(skeleton.names[p], "translation")] = Track("translation", times, carried,
-                                                           "linear")
-    local_t = world[:, :3] if p < 0 else np.einsum("fab,fb->fa", np.linalg.inv(mats[:, p]),
-                                                   world)[:, :3]
-    tracks[(skeleton.names[hips], "translation")] = Track("translation", times, local_t,
-                                                          "linear")
-    return Clip(name, skeleton, tracks, duration=max(source_clip.duration, times[-1]),
-                loop=source_clip.loop)
