@@ -42,7 +42,9 @@ def to_clip(skeleton, mats, rot, times, name, source_clip, hips, hips_rest):
         p = skeleton.parents[j]
         local = rot[:, j] if p < 0 else np.swapaxes(rot[:, p], -1, -2) @ rot[:, j]
         quats = Rotation.from_matrix(local).as_quat()
-        if np.allclose(np.abs(quats @ skeleton.rest_rotation[j]), 1.0, atol=1e-9):
+        # rtol=0: a turn of a fraction of a degree is motion too (allclose's default relative
+        # tolerance of 1e-5 on the dot product would drop turns below 0.5 degrees)
+        if np.allclose(np.abs(quats @ skeleton.rest_rotation[j]), 1.0, rtol=0.0, atol=1e-12):
             continue
         tracks[(skeleton.names[j], "rotation")] = Track("rotation", times, quats, "slerp")
     p = skeleton.parents[hips]

@@ -346,6 +346,10 @@ def _transfer(src, tgt, inverse, smats, scal, rf, contact):
             for k, side in enumerate("LR") for part in ("foot", "toe")
             if f"{part}_{side}" in tgt.slots} if humanoid else {}
     pairs = []
+    above_hips, a = set(), tgt.hips
+    while a >= 0:
+        above_hips.add(a)
+        a = tsk.parents[a]
     for j in range(nj):
         p = tsk.parents[j]
         if j not in inverse:
@@ -375,7 +379,9 @@ def _transfer(src, tgt, inverse, smats, scal, rf, contact):
         else:
             x, _ = Rotation.align_vectors([s_fwd, s_left], [tgt.forward, tgt.left])
         r = s_rot[:, s] @ (sc_rot[s].T @ x.as_matrix() @ t_rot_c[j])
-        if vt is not None and j != tgt.hips:
+        # the hips and what carries them (a ground-level root) turn as the source's do: their
+        # "bone" to the next joint is no limb
+        if vt is not None and j not in above_hips:
             u = t_rot_c[j].T @ vt
             want = _end_points(smats, s_spec) - smats[:, s, :3, 3]
             if j in flat:
