@@ -68,7 +68,8 @@ def load_rig(rig=None, weights_method=None, scale=None):
 
 
 def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_feet=True):
-    """Retarget a clip onto another humanoid (see :func:`rigedit.rigging.retarget`)."""
+    """Retarget a clip onto another character: two humanoids, or any two skeletons with legs
+    whose joints share names or are mapped (see :func:`rigedit.rigging.retarget`)."""
     from .rigging.retarget import retarget as _retarget
 
     return _retarget(source_rig, source_clip, target_rig, map=map, name=name,

@@ -1,6 +1,7 @@
-"""Rigging above the model: humanoid joint mapping and motion retargeting (numpy + scipy).
+"""Rigging above the model: joint mapping and motion retargeting (numpy + scipy).
 
 - :mod:`.name_map`: canonical humanoid slots from names and tree structure, joint maps.
+- :mod:`.limbs`: legs of any skeleton found by structure (quadrupeds and others).
 - :mod:`.retarget`: transfer a clip between skeletons with different rest poses and sizes.
 - :mod:`.contacts`: foot contacts in the source, leg IK clean-up on the target.
 """
