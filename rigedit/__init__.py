@@ -17,7 +17,7 @@ from .errors import RigFileError
 from .model import Pose, Skeleton, SkinBinding
 from .rig import Rig
 
-__all__ = ["load_rig", "save_rig", "retarget", "resolve_rig_path", "BUNDLED", "ASSETS_DIR", "Rig",
+__all__ = ["load_rig", "save_rig", "retarget", "autorig", "resolve_rig_path", "BUNDLED", "ASSETS_DIR", "Rig",
            "Skeleton", "Pose", "Clip", "Track", "SkinBinding", "RigFileError"]
 __version__ = "0.1.0"
 
@@ -74,6 +74,17 @@ def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_fee
 
     return _retarget(source_rig, source_clip, target_rig, map=map, name=name,
                      clean_feet=clean_feet)
+
+
+def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", clips=True,
+            progress=None):
+    """Rig a static mesh: embed a template skeleton, bind it, give it the template's clips
+    (see :func:`rigedit.rigging.autorig.autorig`); ``rig.autorig_report`` says what was
+    decided (orientation, checks, stage times)."""
+    from .rigging.autorig import autorig as _autorig
+
+    return _autorig(mesh, template=template, up=up, forward=forward, weights=weights,
+                    clips=clips, progress=progress)
 
 
 def save_rig(rig, path, clips=None):

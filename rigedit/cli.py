@@ -1,4 +1,5 @@
-"""The ``rigedit`` command: headless jobs on rigs (info, list, weights, render).
+"""The ``rigedit`` command: headless jobs on rigs (info, list, weights, render, export,
+retarget, autorig).
 
 Bad input (a missing or malformed file, an unknown clip or joint) prints one line naming the
 file and the problem and exits with status 2; no traceback. An output in a folder that does
@@ -177,6 +178,12 @@ def cmd_retarget(args):
     return run_retarget(args, _load)
 
 
+def cmd_autorig(args):
+    from .rigging.autorig_command import run_autorig
+
+    return run_autorig(args)
+
+
 def _scale_option(s):
     s.add_argument("--scale", type=float, default=None, metavar="M",
                    help="metres per file unit of a .bvh RIG (default: guessed from its height)")
@@ -239,6 +246,21 @@ def build_parser():
     s.add_argument("-o", "--output", required=True, metavar="FOLDER|OUT.glb|CLIP.json")
     _scale_option(s)
     s.set_defaults(func=cmd_retarget)
+    s = sub.add_parser("autorig", help="embed a template skeleton in a static mesh, bind it "
+                                       "and give it the template's clips")
+    s.add_argument("mesh", metavar="MESH", help="OBJ, PLY, STL, VTK, VTU, VTP or a .glb/.gltf's mesh")
+    s.add_argument("--template", default="humanoid", metavar="humanoid|quadruped|SKELETON",
+                   help="a bundled character's skeleton, or a skeleton .json, rig folder, "
+                        ".glb or .bvh (its clips come along)")
+    s.add_argument("--up", default=None, metavar="AXIS",
+                   help="the mesh's up axis (y, -z, ...; default: guessed and reported)")
+    s.add_argument("--forward", default=None, metavar="AXIS",
+                   help="the way the character faces (z, -x, ...; default: guessed)")
+    s.add_argument("--method", default="heat", help="skin weights: heat (default) or idw")
+    s.add_argument("--no-clips", action="store_true", help="do not retarget the template's clips")
+    s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    s.add_argument("-o", "--output", required=True, metavar="RIG_FOLDER|OUT.glb")
+    s.set_defaults(func=cmd_autorig)
     return p
 
 
@@ -254,7 +276,8 @@ def main(argv=None):
         with interruptible():
             check_options(args)
             if getattr(args, "output", None) is not None:
-                check_output(args.output, folder_ok=args.func in (cmd_export, cmd_retarget))
+                check_output(args.output, folder_ok=args.func in (cmd_export, cmd_retarget,
+                                                                    cmd_autorig))
             return args.func(args)
     except Interrupted as exc:
         print(f"rigedit: interrupted by {exc}", file=sys.stderr)

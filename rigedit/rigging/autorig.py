@@ -1,0 +1,345 @@
+"""Any mesh to an animated character: ``rigedit.autorig`` (issue 11, section 1).
+
+The pipeline, each stage timed in ``rig.autorig_report.seconds``:
+
+1. **load/check** (:mod:`.mesh_check`): read the mesh, weld it, refuse one too far from closed;
+2. **orient** (:mod:`.orient`): up and forward given or guessed; the mesh is turned into
+   rigedit's frame (+Y up, facing +Z), keeps its units, and is moved to stand on y = 0
+   centred over the origin in x and z (``report.transform``, input -> rig);
+3. **embedding** (:mod:`rigedit.embedding`, Baran and Popovic's Pinocchio): every template
+   joint placed inside the mesh;
+4. **skeleton**: the template's names, hierarchy and deform flags on the embedded positions.
+   Joint frames follow the template's: a joint's model-space rest rotation is the
+   template's, turned by the smallest rotation taking the template's bone to the embedded one
+   (for a joint with several children, the rotation that best takes all its child bones to
+   theirs; a leaf keeps its parent's turn; a root keeps the template's frame). So bone rolls
+   stay as the template's animator made them, and the template's clips mean the same motion;
+5. **weights**: bone heat (or another method of :mod:`rigedit.model.weights`) on the whole
+   mesh, small parts included;
+6. **clips**: each template clip through :func:`rigedit.rigging.retarget.retarget` (bones
+   made to point as the template's in model space, root motion scaled by leg length, feet
+   held during contacts), so the character walks at once.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..errors import RigFileError
+from .mesh_check import check_mesh, read_mesh
+from .orient import Orientation, axis_name, orient
+
+__all__ = ["autorig", "AutorigReport", "load_template", "build_skeleton", "STAGES"]
+
+#: Progress bands of the stages (start, end) as fractions of the whole run.
+STAGES = {"load/check": (0.0, 0.05), "orient": (0.05, 0.1), "embedding": (0.1, 0.6),
+          "skeleton": (0.6, 0.62), "weights": (0.62, 0.85), "clips": (0.85, 1.0)}
+
+
+@dataclass
+class AutorigReport:
+    """What :func:`autorig` decided and measured (``rig.autorig_report``).
+
+    Attributes
+    ----------
+    source : str
+        The mesh (its path, or ``"mesh"`` for arrays).
+    template : str
+    orientation : Orientation
+        Up and forward in the input's coordinates, whether guessed and whether sure.
+    transform : (4, 4) float64
+        Input coordinates -> the rig's (a rotation, then a translation).
+    checks : MeshCheck
+    seconds : dict[str, float]
+        Wall seconds per stage (the embedding's own stages prefixed ``embedding/``), and
+        ``total``.
+    cost : float
+        The embedding's penalty.
+    placed : list[str]
+        Joints the embedding placed from the mesh (the rest are carried from the template).
+    clips : dict[str, str]
+        Each template clip -> ``"retargeted"`` or why it was left out.
+    """
+
+    source: str
+    template: str
+    orientation: Orientation
+    transform: np.ndarray
+    checks: object
+    seconds: dict = field(default_factory=dict)
+    cost: float = 0.0
+    placed: list = field(default_factory=list)
+    clips: dict = field(default_factory=dict)
+
+    def lines(self):
+        """The report as short lines (the CLI prints them)."""
+        o = self.orientation
+        out = [f"orientation: {o.describe()}"]
+        if o.guessed:
+            out.append("orientation cues: " + ", ".join(f"{k} {v:.3g}" for k, v in o.notes.items()))
+        t = self.transform[:3, 3]
+        out.append(f"placed: turned into +Y up, facing +Z, moved by ({t[0]:.4g}, {t[1]:.4g}, "
+                   f"{t[2]:.4g}) to stand on y = 0")
+        out += list(self.checks.lines())
+        out.append(f"embedding: template {self.template}, {len(self.placed)} joints placed "
+                   f"from the mesh, cost {self.cost:.4g}")
+        for name, how in self.clips.items():
+            out.append(f"clip {name}: {how}")
+        out.append("seconds: " + ", ".join(f"{k} {v:.2f}" for k, v in self.seconds.items()))
+        return out
+
+
+def load_template(template):
+    """The template's rig (for its clips; None for a bare skeleton), skeleton and a name.
+
+    Parameters
+    ----------
+    template : str, Path, Rig or Skeleton
+        ``"humanoid"``, ``"quadruped"``, a skeleton JSON file, a rig folder, a ``.glb``/
+        ``.gltf`` or ``.bvh`` file, or a rig or skeleton object.
+
+    Raises
+    ------
+    RigFileError
+        A file that is not a skeleton, or a skeleton without limbs (fewer than 3 joints).
+    """
+    from ..model.skeleton import Skeleton
+    from ..rig import Rig
+
+    if isinstance(template, Rig):
+        rig, skeleton, name = template, template.skeleton, template.name
+    elif isinstance(template, Skeleton):
+        rig, skeleton, name = None, template, "skeleton"
+    else:
+        from .. import BUNDLED, load_rig
+        from ..io.mesh import MESH_SUFFIXES
+
+        path = Path(template)
+        name = str(template)
+        suffix = path.suffix.lower()
+        if suffix in MESH_SUFFIXES:
+            raise RigFileError(path, f"expected a template skeleton (humanoid, quadruped, a "
+                                     f"skeleton .json, a rig folder, .glb or .bvh), got a "
+                                     f"{suffix} mesh")
+        if suffix == ".json":
+            from ..io.frames import axis_change, change_axes
+            from ..io.skeleton_json import load_skeleton
+
+            skeleton, meta = load_skeleton(path)
+            if meta["up"] != "y":
+                skeleton, _ = change_axes(skeleton, {}, axis_change(meta["up"], "y"))
+            rig = None
+        elif str(template) in BUNDLED or path.exists() or suffix in (".glb", ".gltf", ".bvh"):
+            rig = load_rig(template)
+            skeleton = rig.skeleton
+        else:
+            raise RigFileError(path, "expected a template: humanoid, quadruped, a skeleton "
+                                     "file, a rig folder, .glb or .bvh; got nothing there")
+    if len(skeleton) < 3:
+        raise RigFileError(name, f"expected a template skeleton with a body and limbs, got "
+                                 f"{len(skeleton)} joint{'s' * (len(skeleton) != 1)}")
+    return rig, skeleton, name
+
+
+def _rest_model(skeleton):
+    return skeleton.forward(skeleton.rest_local_matrices())
+
+
+def build_skeleton(template, positions):
+    """The template's joints at new positions, frames turned as the module notes say.
+
+    Parameters
+    ----------
+    template : Skeleton
+    positions : (J, 3) float64
+        Model-space position of every template joint, template order.
+
+    Returns
+    -------
+    Skeleton
+    """
+    from ..model.skeleton import Skeleton
+
+    positions = np.asarray(positions, dtype=np.float64)
+    rest = _rest_model(template)
+    t_pos = rest[:, :3, 3]
+    t_rot = Rotation.from_matrix(rest[:, :3, :3]).as_matrix()  # scale dropped
+    n = len(template)
+    turn = np.tile(np.eye(3), (n, 1, 1))
+    t_len = e_len = 0.0
+    for j in range(n):
+        p = template.parents[j]
+        kids = template.children(j)
+        a = t_pos[kids] - t_pos[j]
+        b = positions[kids] - positions[j]
+        ok = (np.linalg.norm(a, axis=1) > 1e-9) & (np.linalg.norm(b, axis=1) > 1e-9)
+        t_len += np.linalg.norm(a, axis=1).sum()
+        e_len += np.linalg.norm(b, axis=1).sum()
+        if p < 0:
+            continue                       # a root keeps the template's frame (its facing)
+        if not ok.any():
+            turn[j] = turn[p]              # a leaf turns with its parent
+            continue
+        w = np.linalg.norm(b[ok], axis=1)
+        r, _ = Rotation.align_vectors(b[ok], a[ok], weights=w if ok.sum() > 1 else None)
+        turn[j] = r.as_matrix()
+    model_rot = turn @ t_rot
+    local_t = np.empty((n, 3))
+    local_r = np.empty((n, 3, 3))
+    for j in range(n):
+        p = template.parents[j]
+        if p < 0:
+            local_t[j], local_r[j] = positions[j], model_rot[j]
+        else:
+            local_t[j] = model_rot[p].T @ (positions[j] - positions[p])
+            local_r[j] = model_rot[p].T @ model_rot[j]
+    scale = e_len / t_len if t_len > 0 else 1.0
+    tails = np.full((n, 3), np.nan)
+    has = np.all(np.isfinite(template.tails), axis=1)
+    if has.any():
+        t_tails = template.tails[has]
+        # tails are given at bind time; carried relative to the bind head, turned and scaled
+        heads = template.bind_matrices[has, :3, 3]
+        tails[has] = positions[has] + scale * np.einsum("tij,tj->ti", turn[has], t_tails - heads)
+    return Skeleton(list(template.names), template.parents.copy(), local_t,
+                    Rotation.from_matrix(local_r).as_quat(), tails=tails,
+                    deform=template.deform.copy())
+
+
+def _upright(skeleton):
+    """A template stands tall (a biped) when it stands on at most two feet: leaf joints
+    within 10% of its height of the lowest joint (a quadruped has four hooves there; its
+    height says nothing, antlers make the elk taller than long)."""
+    pos = _rest_model(skeleton)[:, :3, 3]
+    leaves = np.setdiff1d(np.arange(len(skeleton)), skeleton.parents)
+    low = pos[leaves, 1] <= pos[:, 1].min() + 0.1 * max(np.ptp(pos[:, 1]), 1e-12)
+    return bool(low.sum() <= 2)
+
+
+def _placement(vertices, orientation):
+    """(4, 4) input -> rig: turn into rigedit's frame, stand on y = 0, centre x and z."""
+    m = np.eye(4)
+    m[:3, :3] = orientation.rotation
+    turned = vertices @ m[:3, :3].T
+    lo, hi = turned.min(axis=0), turned.max(axis=0)
+    m[:3, 3] = [-(lo[0] + hi[0]) / 2, -lo[1], -(lo[2] + hi[2]) / 2]
+    return m
+
+
+def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", clips=True,
+            progress=None):
+    """Rig a static mesh with a template skeleton (see the module notes).
+
+    Parameters
+    ----------
+    mesh : str, Path or (vertices (V, 3), faces (F, 3))
+        A mesh file (OBJ, PLY, STL, OFF, VTK, VTP..., or a .glb's mesh) or arrays.
+    template : str, Path, Rig or Skeleton
+        ``"humanoid"``, ``"quadruped"``, a skeleton file, rig folder, .glb or .bvh (its clips
+        come along), or an object.
+    up, forward : str, optional
+        Axes of the input such as ``"y"``, ``"-x"``; guessed when omitted (and reported).
+    weights : str
+        Skin weights method (``"heat"``, ``"idw"``).
+    clips : bool
+        Give the template's clips to the new character.
+    progress : callable(fraction, stage), optional
+        Called as the work advances; an exception it raises cancels.
+
+    Returns
+    -------
+    Rig
+        With ``rig.autorig_report`` (:class:`AutorigReport`).
+
+    Raises
+    ------
+    RigFileError
+        Naming the mesh (or template) file and what is wrong: not closed enough, no limbs
+        like the template's, a template that is not a skeleton.
+    """
+    from ..embedding import EmbeddingError, embed_skeleton
+    from ..model.weights import compute_weights
+    from ..rig import Rig
+
+    report = progress or (lambda fraction, stage: None)
+    seconds = {}
+    t_all = time.perf_counter()
+
+    def band(stage):
+        lo, hi = STAGES[stage]
+        return lambda f: report(lo + (hi - lo) * float(f), stage)
+
+    t0 = time.perf_counter()
+    band("load/check")(0.0)
+    t_rig, t_sk, t_name = load_template(template)
+    if isinstance(mesh, (str, Path)):
+        source = str(mesh)
+        vertices, faces = read_mesh(mesh)
+    else:
+        source = "mesh"
+        vertices, faces = (np.asarray(a) for a in mesh)
+        vertices = vertices.astype(np.float64)
+        faces = faces.astype(np.int64)
+    checks = check_mesh(vertices, faces, source)
+    seconds["load/check"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    band("orient")(0.0)
+    body_v, body_f = checks.vertices, checks.faces[checks.body]
+    try:
+        orientation = orient(body_v, body_f, upright=_upright(t_sk), up=up, forward=forward)
+    except ValueError as exc:
+        raise RigFileError(source, str(exc)) from None
+    place = _placement(vertices, orientation)
+    seconds["orient"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    used = np.unique(body_f)
+    remap = np.full(len(body_v), -1, dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    emb_v = body_v[used] @ place[:3, :3].T + place[:3, 3]
+    try:
+        emb = embed_skeleton(emb_v, remap[body_f], t_sk, progress=band("embedding"))
+    except EmbeddingError as exc:
+        raise RigFileError(source, f"{exc} (template {t_name}, orientation "
+                                   f"{orientation.describe()})") from None
+    seconds["embedding"] = time.perf_counter() - t0
+    for k, v in emb.seconds.items():
+        seconds[f"embedding/{k}"] = v
+
+    t0 = time.perf_counter()
+    skeleton = build_skeleton(t_sk, emb.positions)
+    seconds["skeleton"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    rig_v = vertices @ place[:3, :3].T + place[:3, 3]
+    idx, w = compute_weights(rig_v, skeleton, weights, faces=faces, progress=band("weights"))
+    name = Path(source).stem if source != "mesh" else "autorig"
+    rig = Rig(skeleton, rig_v, faces, idx, w, name=name, up="y", weights_method=weights)
+    rig.weights_computed = True
+    seconds["weights"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    clip_notes = {}
+    if clips and t_rig is not None and t_rig.clips:
+        from .retarget import retarget
+
+        names = sorted(t_rig.clips)
+        for i, clip_name in enumerate(names):
+            band("clips")(i / len(names))
+            try:
+                rig.clips[clip_name] = retarget(t_rig, t_rig.clips[clip_name], rig)
+                clip_notes[clip_name] = "retargeted"
+            except ValueError as exc:  # a clip the retargeting cannot carry: say why
+                clip_notes[clip_name] = f"left out: {exc}"
+    seconds["clips"] = time.perf_counter() - t0
+    band("clips")(1.0)
+    seconds["total"] = time.perf_counter() - t_all
+    rig.autorig_report = AutorigReport(source, t_name, orientation, place, checks, seconds,
+                                       emb.cost, list(emb.placed), clip_notes)
+    rig.notes["autorig"] = (f"template {t_name}; orientation {orientation.describe()}")
+    return rig
