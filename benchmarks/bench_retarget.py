@@ -82,7 +82,7 @@ def quadrupeds(markdown):
     from quadruped_variants import VARIANTS, renamed, variant
 
     quad = rigedit.load_rig("quadruped")
-    head = ["clip", "target", "legs°", "spine°", "head°", "tail°", "slip src mm",
+    head = ["clip", "target", "legs°", "spine°", "neck/head°", "tail°", "slip src mm",
             "slip before", "slip after", "contacts", "lowest before mm", "lowest after mm",
             "time s"]
     targets = {"itself": (quad, None)}
