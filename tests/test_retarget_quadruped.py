@@ -247,3 +247,41 @@ def test_template_clips_onto_a_character_of_its_names(template):
         assert err["legs"] < 3.0, (name, err)
         assert lowest_foot(res) > -1e-6
         assert res.clip.duration == clip.duration and res.clip.skeleton is new_sk
+
+
+def test_blender_style_names_map_by_normalised_names(quad, results):
+    """``HindThigh.L`` for ``hind_thigh_L``: equal normalised names (side and words) pair
+    without a map."""
+    def blender(name):
+        side = ""
+        if name.endswith(("_L", "_R")):
+            name, side = name[:-2], "." + name[-1]
+        return "".join(w.capitalize() for w in name.split("_")) + side
+    target = variant(quad.skeleton, **VARIANTS["long legs, short neck"], rename=blender)
+    res = retarget_result(quad, "walk", target)
+    assert res.mapping == {n: blender(n) for n in quad.skeleton.names}
+    assert np.abs(res.mats - results("long legs, short neck", "walk").mats).max() < 1e-9
+
+
+def test_jittered_joints_as_an_embedding_places_them(quad):
+    """An auto-rigged character's joints are where the embedding put them, not on a clean
+    grid: every joint moved by up to a few centimetres, no tails. The legs are still found,
+    the hooves held and kept above the floor, the body's bones still point as the source's."""
+    sk = quad.skeleton
+    rng = np.random.default_rng(7)
+    trans = sk.rest_translation + np.clip(rng.normal(0, 0.015, sk.rest_translation.shape),
+                                          -0.04, 0.04)
+    trans[0] = 0.0
+    pts = type(sk)(sk.names, sk.parents, trans, deform=sk.deform).bind_matrices[1:, 1, 3]
+    trans[1, 1] -= pts.min()  # hooves on the floor again
+    target = Rig(type(sk)(sk.names, sk.parents, trans, deform=sk.deform), np.zeros((0, 3)),
+                 np.zeros((0, 3), dtype=np.int64))
+    for clip in ("walk", "run"):
+        res = retarget_result(quad, clip, target)
+        assert len(res.target_calibration.legs) == 4
+        assert res.contact.any(axis=0).all()
+        assert foot_slip(target_foot_points(res), res.contact).max() < 1e-6
+        assert lowest_foot(res) > -1e-6
+        err = direction_errors(res)
+        assert max(err[g] for g in ("spine", "head", "tail")) < 1e-6, err
+        assert err["legs"] < 3.0, err

@@ -289,7 +289,8 @@ def auto_map(src_skeleton, src_points, tgt_skeleton, tgt_points, src_what="sourc
 
 def name_pairs(src_skeleton, tgt_skeleton, taken=None):
     """Joints paired by name: equal names first, then equal normalised names (side and base
-    word, :func:`normalise_name`) where exactly one joint on each side has it.
+    word, :func:`normalise_name`) with their numbers (``spine_2`` and ``Spine2``), then
+    without them, each where exactly one joint on each side has it.
 
     Parameters
     ----------
@@ -311,17 +312,23 @@ def name_pairs(src_skeleton, tgt_skeleton, taken=None):
     s_used |= set(out)
     t_used |= set(out.values())
 
-    def keyed(names, used):
+    def numbers(nm):
+        return tuple(int(d) for d in re.findall(r"\d+", nm.split(":")[-1].split("|")[-1]))
+
+    def keyed(names, used, key):
         keys = {}
         for nm in names:
             if nm not in used:
-                keys.setdefault(normalise_name(nm), []).append(nm)
+                keys.setdefault(key(nm), []).append(nm)
         return keys
 
-    s_keys = keyed(src_skeleton.names, s_used)
-    for key, cand in keyed(tgt_skeleton.names, t_used).items():
-        if key[1] and len(cand) == 1 and len(s_keys.get(key, [])) == 1:
-            out[s_keys[key][0]] = cand[0]
+    for key in (lambda nm: normalise_name(nm) + numbers(nm), normalise_name):
+        s_keys = keyed(src_skeleton.names, s_used, key)
+        for k, cand in keyed(tgt_skeleton.names, t_used, key).items():
+            if k[1] and len(cand) == 1 and len(s_keys.get(k, [])) == 1:
+                out[s_keys[k][0]] = cand[0]
+                s_used.add(s_keys[k][0])
+                t_used.add(cand[0])
     return out
 
 
