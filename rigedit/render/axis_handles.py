@@ -6,7 +6,7 @@ import numpy as np
 import pyvista as pv
 
 from .joint_glyphs import ACTIVE_COLOR
-from .observers import add_mouse_observers, remove_observers
+from .observers import LeftButtonDrag, remove_observers
 from .ray import closest_on_line, mouse_ray, world_to_display
 
 __all__ = ["AxisHandles", "AXIS_COLORS"]
@@ -14,7 +14,7 @@ __all__ = ["AxisHandles", "AXIS_COLORS"]
 AXIS_COLORS = ((0.90, 0.25, 0.25), (0.30, 0.80, 0.30), (0.30, 0.50, 0.95))
 
 
-class AxisHandles:
+class AxisHandles(LeftButtonDrag):
     """X, Y and Z arrows at the selected joint, each a handle: a left press on an arrow starts
     a drag constrained to that world axis (Blender's translate gizmo). The toolbar's
     constraint axis is drawn brighter and thicker; the grabbed arrow turns yellow.
@@ -76,10 +76,7 @@ class AxisHandles:
         if interactive is None:
             interactive = on_move is not None
         if iren is not None and interactive:
-            self._observers = add_mouse_observers(
-                iren, {"LeftButtonPressEvent": self._press, "MouseMoveEvent": self._mouse_move,
-                       "LeftButtonReleaseEvent": self._release},
-                self.PRIORITY, self, "axis handle")
+            self._observers = self.observe(iren, self.PRIORITY, "axis handle")
 
     # ------------------------------------------------------------------ drawing
     def set_position(self, p):
@@ -187,14 +184,9 @@ class AxisHandles:
     def on_error(self, handler):
         self._on_error = handler
 
-    def _press(self, iren):
-        """Returns True when the press is ours (the sphere widgets and camera never see it)."""
-        if self._grab is not None:
-            return True
-        x, y = iren.GetEventPosition()
-        k = self.pick(x, y)
-        if k is None:
-            return False
+    # ------------------------------------------------------------------ dragging
+    def start_drag(self, k, x, y):
+        """Grab arrow ``k`` at display pixel (x, y); calls ``on_start(k)``."""
         e = np.eye(3)[k]
         anchor = self.position()
         s0 = closest_on_line(anchor, e, *self.ray(x, y))
@@ -203,35 +195,28 @@ class AxisHandles:
         self.set_grabbed(k)
         if self.on_start:
             self.on_start(k)
-        iren.Render()
-        return True
 
-    def _mouse_move(self, iren):
+    def drag_to_pixel(self, x, y):
+        """The point of the axis line nearest the mouse ray, kept at the grab offset (the
+        joint moves with the mouse, it does not jump to it); calls ``on_move(k, target)``."""
         grab = self._grab
-        if grab is None:
-            return False
         k = grab["axis"]
         e = np.eye(3)[k]
-        s = closest_on_line(grab["anchor"], e, *self.ray(*iren.GetEventPosition()))
+        s = closest_on_line(grab["anchor"], e, *self.ray(x, y))
         if s is not None:
-            # keep the grab offset: the joint moves with the mouse, it does not jump to it
             grab["last"] = grab["anchor"] + (s - grab["s0"]) * e
         if self.on_move:
             self.on_move(k, grab["last"].copy())
-        iren.Render()
-        return True
 
-    def _release(self, iren):
+    def end_drag(self):
         grab, self._grab = self._grab, None
         if grab is None:
-            return False
+            return
         try:
             if self.on_end:
                 self.on_end(grab["axis"])
         finally:
             self.set_grabbed(None)
-            iren.Render()
-        return True
 
     def remove(self):
         """Stop listening to the interactor (the actors go with the renderer)."""

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .joint_glyphs import JointGlyphs
-from .observers import add_mouse_observers, remove_observers
+from .observers import LeftButtonDrag, remove_observers
 from .ray import display_to_world, mouse_ray, pixel_spacing, sphere_entries, world_to_display
 
 __all__ = ["JointGizmos", "gizmo_radius"]
@@ -36,7 +36,7 @@ def gizmo_radius(rig):
     return max(r, 1e-4 * extent)
 
 
-class JointGizmos:
+class JointGizmos(LeftButtonDrag):
     """Draggable spheres at joint positions.
 
     Parameters
@@ -82,9 +82,8 @@ class JointGizmos:
         self.renderer.AddActor(self.glyphs.actor)
         iren = getattr(plotter.iren, "interactor", None) if plotter.iren is not None else None
         self._iren = iren
-        self._observers = [] if iren is None else add_mouse_observers(
-            iren, {"LeftButtonPressEvent": self._press, "MouseMoveEvent": self._mouse_move,
-                   "LeftButtonReleaseEvent": self._release}, self.PRIORITY, self, "joint gizmo")
+        self._observers = [] if iren is None else self.observe(iren, self.PRIORITY,
+                                                               "joint gizmo")
 
     # ------------------------------------------------------------------ state
     def __len__(self):
@@ -209,44 +208,12 @@ class JointGizmos:
         finally:
             self.end_drag()
 
-    # ------------------------------------------------------------------ mouse events
-    def _press(self, iren):
-        """True when the press is on a sphere (the camera never sees it)."""
-        if self._grab is not None:
-            return True
-        x, y = iren.GetEventPosition()
+    def hover(self, iren, x, y):
+        """Highlight the sphere a press would grab."""
         j = self.pick(x, y)
-        if j is None:
-            return False
-        try:
-            self.start_drag(j, x, y)
-        finally:
+        if j != self.hovered:
+            self.glyphs.set_state(hovered=j)
             iren.Render()
-        return True
-
-    def _mouse_move(self, iren):
-        x, y = iren.GetEventPosition()
-        if self._grab is None:
-            # hover: highlight the sphere a press would grab; the move goes on to the camera
-            j = self.pick(x, y)
-            if j != self.hovered:
-                self.glyphs.set_state(hovered=j)
-                iren.Render()
-            return False
-        try:
-            self.drag_to_pixel(x, y)
-        finally:
-            iren.Render()
-        return True
-
-    def _release(self, iren):
-        if self._grab is None:
-            return False
-        try:
-            self.end_drag()
-        finally:
-            iren.Render()
-        return True
 
     def remove(self):
         """Stop listening to the interactor and take the actor out of its renderer."""

@@ -56,6 +56,7 @@ class JointGlyphs:
         positions = np.asarray(positions, dtype=float).reshape(-1, 3)
         self.radius = float(radius)
         self.points = pv.PolyData(positions.copy())
+        self._xyz = self.points.points  # a view of VTK's array, kept: the wrapper costs 50 us
         n = len(positions)
         self.deform = np.ones(n, dtype=bool) if deform is None else \
             np.asarray(deform, dtype=bool).reshape(n)
@@ -90,17 +91,17 @@ class JointGlyphs:
         self._recolor()
 
     def __len__(self):
-        return self.points.n_points
+        return len(self._xyz)
 
     # ------------------------------------------------------------------ positions
     @property
     def positions(self):
         """(J, 3) float64 view of the sphere centres (write through :meth:`set_positions`)."""
-        return self.points.points
+        return self._xyz
 
     def set_positions(self, positions, skip=None):
         """Move every sphere (but ``skip``) onto ``positions`` (J, 3)."""
-        pts = self.points.points
+        pts = self._xyz
         if skip is None:
             pts[:] = positions
         else:
@@ -110,7 +111,7 @@ class JointGlyphs:
         self._points_changed()
 
     def set_center(self, j, p):
-        self.points.points[j] = np.asarray(p, dtype=float)
+        self._xyz[j] = p
         self._points_changed()
 
     def _points_changed(self):

@@ -1,4 +1,5 @@
-"""Mouse observers on a VTK interactor whose exceptions are never lost.
+"""Mouse observers on a VTK interactor whose exceptions are never lost, and the left-button
+drag that the joint spheres and the axis arrows share (:class:`LeftButtonDrag`).
 
 VTK prints and swallows an exception raised in an observer. These helpers keep its traceback
 in the owner's ``errors`` list and hand it to the owner's ``on_error(what)`` handler (the
@@ -10,7 +11,7 @@ from __future__ import annotations
 import traceback
 import warnings
 
-__all__ = ["record_failure", "add_mouse_observers", "remove_observers"]
+__all__ = ["record_failure", "add_mouse_observers", "remove_observers", "LeftButtonDrag"]
 
 
 def record_failure(owner, what):
@@ -65,3 +66,58 @@ def remove_observers(iren, tags):
     if iren is not None:
         for tag in tags:
             iren.RemoveObserver(tag)
+
+
+class LeftButtonDrag:
+    """Left-button drags of a gizmo through interactor observers (a mixin).
+
+    A press where ``pick(x, y)`` finds something starts ``start_drag(item, x, y)``; mouse
+    moves go to ``drag_to_pixel(x, y)``; the release to ``end_drag()``. Each event the drag
+    takes is aborted (the camera never sees it) and asks the interactor to render. A move
+    with no drag goes to ``hover(iren, x, y)`` and on to the camera. The class holds
+    ``_grab`` (None when no drag is under way).
+    """
+
+    _grab = None
+
+    def observe(self, iren, priority, what):
+        """Start listening to ``iren``; returns the observer tags."""
+        return add_mouse_observers(
+            iren, {"LeftButtonPressEvent": self._press, "MouseMoveEvent": self._mouse_move,
+                   "LeftButtonReleaseEvent": self._release}, priority, self, what)
+
+    def hover(self, iren, x, y):
+        """A mouse move with no drag (nothing by default)."""
+
+    def _press(self, iren):
+        if self._grab is not None:
+            return True
+        x, y = iren.GetEventPosition()
+        item = self.pick(x, y)
+        if item is None:
+            return False
+        try:
+            self.start_drag(item, x, y)
+        finally:
+            iren.Render()
+        return True
+
+    def _mouse_move(self, iren):
+        x, y = iren.GetEventPosition()
+        if self._grab is None:
+            self.hover(iren, x, y)
+            return False
+        try:
+            self.drag_to_pixel(x, y)
+        finally:
+            iren.Render()
+        return True
+
+    def _release(self, iren):
+        if self._grab is None:
+            return False
+        try:
+            self.end_drag()
+        finally:
+            iren.Render()
+        return True

@@ -1,0 +1,132 @@
+#!/usr/bin/env python3
+"""What the joint spheres cost in the editor, in one run (issue 12, section 1): the glyph
+actor of today against the forty ``vtkSphereWidget`` s it replaced.
+
+1. Static re-renders of the editor's 3D view (the quadruped, side view, window 1280x720 by
+   default) in three settings, interleaved over rounds (the machine's speed drifts), median
+   of the rounds' medians: the joint spheres as one glyph actor (the editor now); no joint
+   spheres; forty vtkSphereWidgets built as the editor built them before (16 x 12 resolution,
+   surface, in the overlay renderer), glyphs hidden. The joints' cost is each setting minus
+   the one without spheres.
+2. Python per mouse move: moving all spheres onto a new pose (glyph points in place against
+   forty ``SetCenter`` calls) and the hover pick of the mouse ray against every sphere.
+
+Run: ``xvfb-run -a -s "-screen 0 1600x1000x24" .venv/bin/python benchmarks/bench_gizmos.py
+[--size 1280x720] [--rounds 7]``.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import warnings
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import numpy as np  # noqa: E402
+from profile_drag import _median_ms, open_editor  # noqa: E402
+
+
+def old_widgets(w):
+    """Forty vtkSphereWidgets as ``render/gizmos.py`` built them before the glyph actor."""
+    import vtk
+
+    from rigedit.render.joint_glyphs import SPHERE_COLOR
+
+    iren = w.plotter.iren.interactor
+    widgets = []
+    for p in w.gizmos.positions:
+        s = vtk.vtkSphereWidget()
+        s.SetInteractor(iren)
+        s.SetCurrentRenderer(w.overlay)
+        s.SetDefaultRenderer(w.overlay)
+        s.SetRepresentationToSurface()
+        s.SetThetaResolution(16)
+        s.SetPhiResolution(12)
+        s.ScaleOff()
+        s.GetSphereProperty().SetColor(SPHERE_COLOR)
+        s.GetSphereProperty().SetSpecular(0.4)
+        s.SetRadius(w.gizmos.radius)
+        s.SetCenter(*p)
+        widgets.append(s)
+    return widgets
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--size", default="1280x720", help="editor window size")
+    parser.add_argument("--rounds", type=int, default=15)
+    args = parser.parse_args()
+    from PyQt5 import QtWidgets
+    from threadpoolctl import threadpool_limits
+
+    import rigedit
+
+    app = QtWidgets.QApplication.instance() or QtWidgets.QApplication([])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rig = rigedit.load_rig("quadruped")
+    print(f"rig: {rig.name}, {len(rig.faces):,} triangles, {len(rig.skeleton)} joints; "
+          f"load average {os.getloadavg()[0]:.2f} at start")
+    with threadpool_limits(1):
+        w = open_editor(app, rig, tuple(int(v) for v in args.size.split("x")))
+        print(f"3D view {w.plotter.width()}x{w.plotter.height()} px")
+        render = w.plotter.render_window.Render
+        widgets = old_widgets(w)
+        iren = w.plotter.iren.interactor
+
+        def set_widgets(on):
+            iren.EnableRenderOff()
+            for s in widgets:
+                s.SetEnabled(on)
+
+        settings = [
+            ("joint spheres: one glyph actor (now)", lambda: None, lambda: None),
+            ("no joint spheres", lambda: w.gizmos.set_visible(False),
+             lambda: w.gizmos.set_visible(True)),
+            ("joint spheres: 40 vtkSphereWidgets (before)",
+             lambda: (w.gizmos.set_visible(False), set_widgets(True)),
+             lambda: (set_widgets(False), w.gizmos.set_visible(True))),
+        ]
+        times = {label: [] for label, _, _ in settings}
+        for _ in range(args.rounds):
+            for label, on, off in settings:
+                on()
+                times[label].append(_median_ms(render, n=15, warm=2))
+                off()
+        med = {k: float(np.median(v)) for k, v in times.items()}
+        best = {k: float(np.min(v)) for k, v in times.items()}
+        none = "no joint spheres"
+        print("\nstatic re-render of the view: median of the rounds' medians (best round); "
+              "the joints' cost is the difference to no spheres")
+        for label, v in times.items():
+            extra = "" if label == none else \
+                f"  joints {med[label] - med[none]:+6.2f} ms ({best[label] - best[none]:+.2f})"
+            print(f"  {label:46s} {med[label]:6.2f} ms ({best[label]:.2f}){extra}")
+
+        # Python of a mouse move
+        heads = w.gizmos.positions.copy() + 0.01
+        glyph_ms = _median_ms(lambda: w.gizmos.set_positions(heads), n=200)
+
+        def widget_centres():
+            for s, p in zip(widgets, heads):
+                s.SetCenter(float(p[0]), float(p[1]), float(p[2]))
+        widget_ms = _median_ms(widget_centres, n=200)
+        x, y = w.gizmos.display_position(len(heads) // 2)
+        pick_ms = _median_ms(lambda: w.gizmos.pick(x + 40, y + 40), n=200)
+        print("\nper mouse move (Python)")
+        print(f"  move all spheres onto a pose: glyph points {glyph_ms:.3f} ms, "
+              f"40 SetCenter {widget_ms:.3f} ms")
+        print(f"  hover pick (mouse ray against {len(heads)} spheres): {pick_ms:.3f} ms")
+        for s in widgets:
+            s.SetEnabled(False)
+            s.SetInteractor(None)
+        w.close()
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
