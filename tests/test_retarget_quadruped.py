@@ -175,6 +175,8 @@ def test_cli_json_map_onto_renamed_quadruped_and_bad_input(quad, tmp_path):
              "-o", out)
     assert p.returncode == 0, p.stderr
     assert "fore_hoof_L -> Q_ForeHoof.l" in p.stdout
+    assert "legs: target 4 (feet Q_ForeHoof.l, Q_ForeHoof.r, Q_HindHoof.l, Q_HindHoof.r), " \
+        "source 4; hips Q_Pelvis" in p.stdout
     clip = rigedit.io.clip_json.load_clip(out, rigedit.load_rig(folder).skeleton)
     direct = retarget_result(quad, "walk", variant(quad.skeleton,
                                                    **VARIANTS["big (x1.5), short legs"]))
@@ -285,3 +287,30 @@ def test_jittered_joints_as_an_embedding_places_them(quad):
         err = direction_errors(res)
         assert max(err[g] for g in ("spine", "head", "tail")) < 1e-6, err
         assert err["legs"] < 3.0, err
+
+
+def test_bird_toes_make_one_leg():
+    """Three toes branching at a low foot: one leg from the thigh to the lowest toe, the
+    whole foot (foot joint and toes) moving with the ankle."""
+    from rigedit.model import Skeleton
+    from rigedit.rigging.limbs import find_legs
+
+    names = ["hips", "neck", "head"]
+    parents = [-1, 0, 1]
+    trans = [[0, 1.0, 0], [0, 0.3, 0.2], [0, 0.3, 0.1]]
+    for side, x in (("L", 0.1), ("R", -0.1)):
+        base = len(names)
+        names += [f"thigh_{side}", f"shin_{side}", f"foot_{side}", f"toe_a_{side}",
+                  f"toe_b_{side}", f"toe_c_{side}"]
+        parents += [0, base, base + 1, base + 2, base + 2, base + 2]
+        trans += [[x, -0.1, 0], [0, -0.4, 0.05], [0, -0.4, -0.05], [0, -0.1, 0.12],
+                  [0.03, -0.1, 0.1], [0, -0.1, -0.08]]
+    sk = Skeleton(names, parents, np.array(trans, dtype=float))
+    legs, hips, chest = find_legs(sk, sk.bind_matrices)
+    assert len(legs) == 2 and sk.names[hips] == "hips" and chest is None
+    left = legs[0]
+    assert [sk.names[j] for j in left.chain] == ["thigh_L", "shin_L", "foot_L", "toe_a_L"]
+    assert (sk.names[left.upper], sk.names[left.knee], sk.names[left.ankle]) == \
+        ("thigh_L", "shin_L", "foot_L")
+    assert sorted(sk.names[j] for j in left.foot) == ["foot_L", "toe_a_L", "toe_b_L",
+                                                      "toe_c_L"]

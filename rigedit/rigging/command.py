@@ -45,6 +45,11 @@ def run_retarget(args, load):
           f"{res.target_calibration.source}; facing turn {res.facing_degrees:g} deg; "
           f"scale {res.scale:.3f}; contact frames {res.contact.any(axis=1).sum()} of "
           f"{len(res.times)}")
+    tgt = res.target_calibration
+    if tgt.kind == "legs":  # not two humanoids: say which legs were found
+        feet = ", ".join(target.skeleton.names[j] for j in tgt.contacts)
+        print(f"legs: target {len(tgt.legs)} (feet {feet}), source "
+              f"{len(res.source_calibration.legs)}; hips {target.skeleton.names[tgt.hips]}")
     if args.save_map:
         save_map(args.save_map, res.mapping)
         print(f"wrote {Path(args.save_map).resolve()}")
