@@ -1,7 +1,7 @@
 """Retargeting quality and time: the shared BVH files onto the bundled humanoid and CesiumMan,
 and the bundled quadruped's clips onto quadrupeds of other proportions and names.
 
-    .venv/bin/python benchmarks/bench_retarget.py [--markdown] [--quadruped-only]
+    .venv/bin/python benchmarks/bench_retarget.py [--markdown] [--quadruped-only] [--autorig]
 
 For each pair: the mean angle between each mapped target bone and its source bone in model
 space (arms, legs = thigh and shin, spine, head; feet apart: their pitch is transferred
@@ -14,6 +14,10 @@ Quadrupeds (``tests/quadruped_variants.py`` builds the targets from the bundled 
 the same measures per chain group (legs: every bone from the shoulder blade or hip down to
 the hoof; spine: pelvis to the fore legs' branch; head: neck, head, jaw, ears, antlers; tail),
 the slip of each hoof joint during its contacts, and the time of each clip and of all four.
+
+``--autorig``: also each template's clips onto characters auto-rigged from it
+(``rigedit.autorig(mesh, template, clips=False)``, then :func:`retarget_result` per clip, as
+the auto-rigging does): the bundled characters' own meshes and the shared cow and homer.
 """
 from __future__ import annotations
 
@@ -109,6 +113,43 @@ def quadrupeds(markdown):
           + "; ".join(totals))
 
 
+AUTORIG = [(REPO / "assets" / "quadruped" / "mesh.obj", "quadruped"),
+           (DATA / "common-3d-test-models" / "cow.obj", "quadruped"),
+           (REPO / "assets" / "humanoid" / "mesh.obj", "humanoid"),
+           (DATA / "common-3d-test-models" / "homer.obj", "humanoid")]
+
+
+def autorigged(markdown):
+    head = ["mesh", "template clip", "calibrated as", "legs°", "others° (max)", "slip src mm",
+            "slip before", "slip after", "contacts", "lowest before mm", "lowest after mm",
+            "time s"]
+    rows, notes = [], []
+    for mesh, template in AUTORIG:
+        name = f"{mesh.parent.name}/{mesh.name}"
+        t0 = time.perf_counter()
+        try:
+            rig = rigedit.autorig(mesh, template=template, clips=False)
+        except ValueError as exc:
+            notes.append(f"{name}: not auto-rigged: {exc}")
+            continue
+        notes.append(f"{name}: auto-rigged as {template} in {time.perf_counter() - t0:.1f} s")
+        source = rigedit.load_rig(template)
+        for clip in source.clips:
+            t0 = time.perf_counter()
+            res = retarget_result(source, clip, rig)
+            dt = time.perf_counter() - t0
+            cal = res.target_calibration
+            others = [g for g in cal.groups if g not in ("legs", "feet")]
+            m = _measures(res, ["legs"] + others)
+            rows.append([name, clip, cal.kind, m[0],
+                         f"{max(float(x) for x in m[1:1 + len(others)]):.2f}"]
+                        + m[1 + len(others):] + [f"{dt:.3f}"])
+    _table(head, rows, markdown)
+    print()
+    for n in notes:
+        print(n)
+
+
 def main():
     markdown = "--markdown" in sys.argv
     warnings.simplefilter("ignore")
@@ -116,6 +157,9 @@ def main():
         humanoids(markdown)
         print()
     quadrupeds(markdown)
+    if "--autorig" in sys.argv:
+        print()
+        autorigged(markdown)
 
 
 if __name__ == "__main__":
