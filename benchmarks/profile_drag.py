@@ -122,6 +122,8 @@ def profile_rows(profile, moves):
               "show_joint": "  joint panel refresh"}
     rows = {}
     for (filename, _line, name), (_cc, _nc, _tt, ct, _callers) in st.stats.items():
+        if name == "move" and filename.endswith("drag.py"):  # DragController.move
+            name = "_drag_move"
         if name in wanted and "rigedit" in filename:
             rows[name] = rows.get(name, 0.0) + ct
     return [(wanted[k], rows[k] / moves * 1e3) for k in wanted if k in rows]
@@ -176,16 +178,20 @@ def layer_triangles(w):
     import pyvista as pv
     import vtk
 
-    pd = vtk.vtkPolyData()
-    w.gizmos.widgets[0].GetPolyData(pd)
-    sphere = pv.wrap(pd).triangulate()
+    if hasattr(w.gizmos, "glyphs"):  # one glyph actor (issue 12): its sphere source
+        w.gizmos.glyphs.source.Update()
+        sphere = pv.wrap(w.gizmos.glyphs.source.GetOutput()).triangulate()
+    else:
+        pd = vtk.vtkPolyData()
+        w.gizmos.widgets[0].GetPolyData(pd)
+        sphere = pv.wrap(pd).triangulate()
     arrows = sum(pv.wrap(a.GetMapper().GetInput()).triangulate().n_cells for a in w.axes.actors)
     floor = w.plotter.actors["rig-floor"].GetMapper().GetInput()
     grid = w.plotter.actors["rig-grid"].GetMapper().GetInput()
     bones = w.scene.bones
     return {"mesh triangles": len(w.document.rig.faces),
-            "sphere widgets": f"{len(w.gizmos.widgets)} x {sphere.n_cells} = "
-                              f"{len(w.gizmos.widgets) * sphere.n_cells:,} triangles",
+            "joint spheres": f"{len(w.gizmos.positions)} x {sphere.n_cells} = "
+                             f"{len(w.gizmos.positions) * sphere.n_cells:,} triangles",
             "axis arrows": f"{arrows:,} triangles",
             "bones": f"{bones.n_lines} lines",
             "floor plane": f"{pv.wrap(floor).triangulate().n_cells:,} triangles",
@@ -288,6 +294,54 @@ def bare_frames(rig, plotter, mesh, palettes):
     return float(np.median(frame)), float(np.median(render))
 
 
+def bare_qt_frames(app, rig, plotter, mesh, palettes):
+    """Median ms of a bare frame as a pyvistaqt application shows it: skin positions and
+    normals, write them in place, ask the widget to repaint and let Qt paint (VTK's render,
+    the blit into the widget and Qt's compositing of the window), and renders per frame."""
+    rw = plotter.render_window
+    count = [0]
+    obs = rw.AddObserver("EndEvent", lambda *a: count.__setitem__(0, count[0] + 1))
+    frame = []
+    for k, p in enumerate(list(palettes[:3]) + list(palettes)):
+        if k == 3:
+            count[0] = 0
+        t0 = time.perf_counter()
+        pts, nrm = rig.binding.skin_with_normals(p)
+        mesh.points[:] = pts
+        mesh.point_data["Normals"][:] = nrm
+        mesh.GetPointData().GetNormals().Modified()
+        mesh.GetPoints().Modified()
+        mesh.Modified()
+        plotter.update()
+        app.processEvents()
+        frame.append(time.perf_counter() - t0)
+    rw.RemoveObserver(obs)
+    return float(np.median(frame[3:]) * 1e3), count[0] / len(palettes)
+
+
+def playback(app, w, frames=60, fps=30.0):
+    """Median ms of a playback frame in the editor (the timeline's tick: the clip's time set,
+    the pose sampled and shown, the ruler and panels refreshed, one paint), over the walk (or
+    the current clip), and renders per frame."""
+    d = w.document
+    if "walk" in d.clips:
+        d.set_current_clip("walk")
+    duration = d.clips[d.current_clip].duration
+    rw = w.plotter.render_window
+    count = [0]
+    obs = rw.AddObserver("EndEvent", lambda *a: count.__setitem__(0, count[0] + 1))
+    per = []
+    for i in range(frames + 3):
+        if i == 3:
+            count[0] = 0
+        t0 = time.perf_counter()
+        w.timeline.set_time((i / fps) % duration)
+        app.processEvents()
+        per.append(time.perf_counter() - t0)
+    rw.RemoveObserver(obs)
+    return float(np.median(per[3:]) * 1e3), count[0] / frames
+
+
 def drag_palettes(rig, n=60):
     """Skinning palettes of ``n`` IK poses along bench_drag's loop of drag targets."""
     from rigedit.model.ik import drag_joint
@@ -350,6 +404,10 @@ def main():
     parser.add_argument("--profile-top", type=int, default=0,
                         help="also print the drag profile's N costliest functions")
     parser.add_argument("--startup", action="store_true", help="also time app.py start-up")
+    parser.add_argument("--rounds", type=int, default=5,
+                        help="interleaved rounds of the ratio table (r)")
+    parser.add_argument("--no-layers", action="store_true",
+                        help="skip the layer table (c) and the pipeline timings")
     parser.add_argument("--first-frame-child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.first_frame_child:
@@ -361,10 +419,15 @@ def main():
 
     import rigedit
 
+    from rigedit.model import skinning_kernels
+
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication([])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         rig = rigedit.load_rig(None)
+    # the compiled kernels, as app.py loads them half a second after start (both plotters)
+    kernels = skinning_kernels.load()
+    print(f"skinning kernels: {'compiled' if kernels is not None else 'numpy'}")
     print(f"rig: {rig.name}, {len(rig.vertices):,} vertices, {len(rig.faces):,} triangles, "
           f"{len(rig.skeleton)} joints; load average {os.getloadavg()[0]:.2f} at start")
     size = tuple(int(v) for v in args.size.split("x"))
@@ -386,12 +449,33 @@ def main():
     bare_frame = min(bare1[0], bare2[0])
     bare_render = min(bare1[1], bare2[1])
     drag_ms = float(np.median(per_move))
+    # the ratios of issue 12, interleaved: bare frame through Qt, editor drag, editor playback
+    ratio_rows = {"bare": [], "bare render": [], "drag": [], "play": []}
+    for _ in range(args.rounds):
+        ratio_rows["bare"].append(bare_qt_frames(app, rig, bplot, bmesh, palettes[:30]))
+        ratio_rows["bare render"].append((bare_frames(rig, bplot, bmesh, palettes[:30])[1], 1))
+        ratio_rows["drag"].append((float(np.median(drag(app, w, j, 40)[0])), 1.0))
+        ratio_rows["play"].append(playback(app, w, frames=40))
     print(f"\n(a) bare plotter, skinned mesh only: frame {bare1[0]:.1f} / {bare2[0]:.1f} ms "
           f"(before / after the drag), of which render {bare1[1]:.1f} / {bare2[1]:.1f} ms")
     print(f"(b) editor drag: median {drag_ms:.1f} ms per mouse move (p90 "
           f"{np.percentile(per_move, 90):.1f}), {len(renders) / args.moves:.2f} renders per move, "
           f"render median {np.median(renders):.1f} ms; {1e3 / drag_ms:.1f} frames/s; "
           f"{drag_ms / bare_frame:.2f}x the bare frame ({drag_ms / bare_render:.2f}x its render)")
+    med = {k: float(np.median([r[0] for r in v])) for k, v in ratio_rows.items()}
+    spread = {k: (min(r[0] for r in v), max(r[0] for r in v)) for k, v in ratio_rows.items()}
+    print(f"\n(r) in {args.rounds} interleaved rounds (median of the round medians, "
+          f"rounds' range):")
+    for k, label in (("bare render", "bare plotter, render alone"),
+                     ("bare", "bare plotter frame through Qt (skin, update, paint)"),
+                     ("drag", "editor drag frame (one mouse move)"),
+                     ("play", "editor playback frame (timeline tick of the walk)")):
+        extra = "" if k.startswith("bare") else (
+            f"  = {med[k] / med['bare']:.2f}x the bare frame, "
+            f"{med[k] / med['bare render']:.2f}x its render alone")
+        renders = np.mean([r[1] for r in ratio_rows[k]])
+        print(f"    {label:<52} {med[k]:6.1f} ms ({spread[k][0]:.1f}-{spread[k][1]:.1f}; "
+              f"{renders:.2f} renders/frame){extra}")
     print(f"    of a move: VTK event (widget + handler + render) {np.median(invoke):.1f} ms, "
           f"Qt processEvents after it {np.median(per_move - invoke):.1f} ms")
     print(f"    same drag under cProfile: median {np.median(per_move_p):.1f} ms per move")
@@ -399,23 +483,25 @@ def main():
         print(f"    {label:<48} {ms:7.2f} ms/frame")
     if args.profile_top:
         pstats.Stats(prof).sort_stats("tottime").print_stats(args.profile_top)
-    print("\n(c) the editor's pipeline, timed alone on the dragged pose")
-    for label, ms in pipeline_costs(w):
-        print(f"    {label:<58} {ms:7.2f} ms")
-    print("    static re-render of the same pose (no data changed), layers hidden in turn")
-    ren = w.plotter.renderer
-    print(f"    (depth peeling {bool(ren.GetUseDepthPeeling())}, layers "
-          f"{w.plotter.render_window.GetNumberOfLayers()}, renderers "
-          f"{w.plotter.render_window.GetRenderers().GetNumberOfItems()})")
-    rows = layer_costs(app, w)
-    full = rows[0][1]
-    for label, ms, (lo, hi) in rows:
-        print(f"    {label:<58} {ms:7.2f} ms  (saves {full - ms:5.1f}; rounds {lo:.1f}-{hi:.1f})")
-    for k, v in layer_triangles(w).items():
-        print(f"    {k:<20} {v}")
-    bare3 = bare_frames(rig, bplot, bmesh, palettes)
-    print(f"bare plotter again after the layer table: frame {bare3[0]:.1f} ms, render "
-          f"{bare3[1]:.1f} ms")
+    if not args.no_layers:
+        print("\n(c) the editor's pipeline, timed alone on the dragged pose")
+        for label, ms in pipeline_costs(w):
+            print(f"    {label:<58} {ms:7.2f} ms")
+        print("    static re-render of the same pose (no data changed), layers hidden in turn")
+        ren = w.plotter.renderer
+        print(f"    (depth peeling {bool(ren.GetUseDepthPeeling())}, layers "
+              f"{w.plotter.render_window.GetNumberOfLayers()}, renderers "
+              f"{w.plotter.render_window.GetRenderers().GetNumberOfItems()})")
+        rows = layer_costs(app, w)
+        full = rows[0][1]
+        for label, ms, (lo, hi) in rows:
+            print(f"    {label:<58} {ms:7.2f} ms  (saves {full - ms:5.1f}; "
+                  f"rounds {lo:.1f}-{hi:.1f})")
+        for k, v in layer_triangles(w).items():
+            print(f"    {k:<20} {v}")
+        bare3 = bare_frames(rig, bplot, bmesh, palettes)
+        print(f"bare plotter again after the layer table: frame {bare3[0]:.1f} ms, render "
+              f"{bare3[1]:.1f} ms")
     print(f"load average after the run: {os.getloadavg()}")
     w.close()
     bwin.close()

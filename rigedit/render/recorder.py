@@ -25,7 +25,8 @@ import pyvista as pv
 
 from ..errors import RigFileError
 from ..io.atomic import check_output_folder, naming_target, temp_beside
-from .scene import GRID_COLOR, RigScene, joint_points, turn_about, up_vector
+from .floor import GRID_COLOR
+from .scene import RigScene, joint_points, turn_about, up_vector
 
 __all__ = ["record_clip", "frame_times", "camera_state", "apply_camera", "VIDEO_SUFFIXES",
            "RecordingCancelled", "FrameReader"]

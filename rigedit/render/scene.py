@@ -13,6 +13,8 @@ from scipy.spatial.transform import Rotation
 
 from ..model.kinematics import skinning_matrices
 from ..surface import display_texture
+from .floor import add_floor
+from .proxy import ProxyActor
 
 __all__ = ["RigScene", "up_vector", "front_vector", "faces_to_vtk", "turn_about",
            "joint_points"]
@@ -40,13 +42,6 @@ def turn_about(vector, axis, degrees):
     return Rotation.from_rotvec(np.radians(degrees) * np.asarray(axis, float)).apply(vector)
 
 
-def _nice_cell(size):
-    """Round a grid cell size to 1, 2 or 5 times a power of ten (model units)."""
-    exp = np.floor(np.log10(size))
-    base = size / 10 ** exp
-    return float((1 if base < 1.5 else 2 if base < 3.5 else 5) * 10 ** exp)
-
-
 def joint_points(rig, model):
     """(J + T, 3) what a mesh-less rig shows of a pose: its joints and bone tails.
 
@@ -57,44 +52,6 @@ def joint_points(rig, model):
         Model matrices of the pose.
     """
     return np.vstack([model[:, :3, 3], rig.posed_tails(model)[1]])
-
-
-#: The floor's plane and grid line colours and how much of them shows over the background
-#: (:func:`floor_colors`): chosen so that the opaque floor shows the pixels the translucent,
-#: lit floor it replaced showed over the editor's background, within a few levels
-FLOOR_COLOR, FLOOR_ALPHA = "#85857f", 0.2
-GRID_COLOR, GRID_ALPHA = "#6b7580", 0.45
-
-
-def floor_colors(points, center, radius, renderer):
-    """Opaque colours for the floor's points that look like a translucent floor over the
-    renderer's background: the floor colour blended over the background, over its lower
-    colour near the character and over the middle of a gradient background towards the
-    floor's far edge (which shows near the horizon), so the floor fades into the distance.
-
-    Parameters
-    ----------
-    points : (N, 3) float
-    center : (3,) float
-        The floor's centre, under the character.
-    radius : float
-        Distance from the centre at which the far colour is reached.
-    renderer : vtkRenderer
-
-    Returns
-    -------
-    plane, grid : (N, 3) uint8 each
-        RGB of the filled plane and of the grid lines drawn over it.
-    """
-    near = np.array(renderer.GetBackground())
-    far = 0.5 * (near + np.array(renderer.GetBackground2())) \
-        if renderer.GetGradientBackground() else near
-    d = np.linalg.norm(np.asarray(points, float) - center, axis=1) / radius
-    t = np.clip(d, 0.0, 1.0)[:, None]
-    behind = near + (far - near) * (t * t * (3 - 2 * t))  # smoothstep
-    plane = behind + FLOOR_ALPHA * (np.array(pv.Color(FLOOR_COLOR).float_rgb) - behind)
-    grid = plane + GRID_ALPHA * (np.array(pv.Color(GRID_COLOR).float_rgb) - plane)
-    return tuple(np.clip(np.rint(255 * c), 0, 255).astype(np.uint8) for c in (plane, grid))
 
 
 def faces_to_vtk(faces):
@@ -181,6 +138,11 @@ class RigScene:
         self.weights_shown = False
         self._weight_lut = None
         self.joint_positions = sk.bind_matrices[:, :3, 3].copy()
+        #: A :class:`~rigedit.render.proxy.SkinProxy` drawn instead of the mesh while
+        #: :attr:`proxy_shown` (see :meth:`attach_proxy`), or None
+        self.proxy = self.proxy_actor = None
+        self.proxy_shown = False
+        self._model = None   # the last model matrices shown, to skin on a switch
         self.view("front")
 
     # ------------------------------------------------------------------ actors
@@ -303,31 +265,8 @@ class RigScene:
 
     def _add_floor(self):
         points = self.rest_points()
-        lo, hi = points.min(axis=0), points.max(axis=0)
-        extent = float(np.max(hi - lo)) or 1.0
-        # Wide enough that a walk filmed with a following camera never reaches its edge;
-        # cells of a fixed size in model units so motion over the floor reads as speed.
-        cells = 40
-        size = cells * _nice_cell(extent / 4.0)
-        axis = 1 if self.rig.up == "y" else 2
-        ground = np.zeros(3)
-        ground[axis] = min(0.0, lo[axis]) if lo[axis] > -0.05 * extent else lo[axis]
-        plane = pv.Plane(center=ground, direction=self.up, i_size=size, j_size=size,
-                         i_resolution=cells, j_resolution=cells)
-        # Opaque and unlit, in colours that look like the translucent lit floor it replaces
-        # over the background: a translucent plane cost a third of the editor's frame in
-        # software OpenGL and a lit one a fifth (README, Speed > Dragging).
-        grid = plane.extract_all_edges()
-        renderer = self.plotter.renderer
-        plane.point_data["floor-rgb"] = floor_colors(plane.points, ground, size / 2,
-                                                     renderer)[0]
-        grid.point_data["floor-rgb"] = floor_colors(grid.points, ground, size / 2, renderer)[1]
-        fill = self.plotter.add_mesh(plane, scalars="floor-rgb", rgb=True, lighting=False,
-                                     name="rig-floor", reset_camera=False, pickable=False)
-        # the plane pushed back in depth so the opaque lines on it never fight it
-        fill.GetMapper().SetRelativeCoincidentTopologyPolygonOffsetParameters(4.0, 4.0)
-        return self.plotter.add_mesh(grid, scalars="floor-rgb", rgb=True, lighting=False,
-                                     name="rig-grid", reset_camera=False, pickable=False)
+        return add_floor(self.plotter, points.min(axis=0), points.max(axis=0),
+                         1 if self.rig.up == "y" else 2, self.up)
 
     def set_skeleton_visible(self, visible):
         self.bone_actor.SetVisibility(bool(visible))
@@ -403,6 +342,36 @@ class RigScene:
         mapper.ScalarVisibilityOn()
         self.weights_shown = True
 
+    # ------------------------------------------------------------------ proxy
+    def attach_proxy(self, proxy):
+        """Draw ``proxy`` (a :class:`~rigedit.render.proxy.SkinProxy` of this rig's mesh)
+        instead of the mesh while :meth:`show_proxy` says so."""
+        self.detach_proxy()
+        tcoords = self.mesh.active_texture_coordinates if self._texture is not None else None
+        self.proxy_actor = ProxyActor(self.plotter, proxy, self.mesh_actor, self._texture,
+                                      tcoords)
+        self.proxy = proxy
+
+    def detach_proxy(self):
+        """Drop the proxy; the mesh is drawn again."""
+        self.show_proxy(False)
+        if self.proxy_actor is not None:
+            self.proxy_actor.remove()
+        self.proxy = self.proxy_actor = None
+
+    def show_proxy(self, on):
+        """Draw the proxy (``True``) or the full mesh; the one shown is skinned to the last
+        pose at once. Returns whether that changed what is drawn."""
+        on = bool(on) and self.proxy is not None
+        if on == self.proxy_shown:
+            return False
+        self.proxy_shown = on
+        self.proxy_actor.set_visible(on)
+        self.mesh_actor.SetVisibility(not on)
+        if self._model is not None:
+            self.update_from_matrices(self._model)
+        return True
+
     # ------------------------------------------------------------------ per frame
     def update(self, pose):
         """Skin ``pose`` and write it into the existing actors (no re-add, no render).
@@ -418,8 +387,11 @@ class RigScene:
     def update_from_matrices(self, model, skin=True):
         """Same as :meth:`update` from model matrices already computed; ``skin=False``
         moves the bones only (the mesh keeps its points)."""
+        self._model = np.array(model, dtype=float)
         if not self.has_mesh:
             self._update_bare_skeleton(model)
+        elif skin and self.proxy_shown:
+            self.proxy_actor.skin(skinning_matrices(self.rig.skeleton, model), self._skinning)
         elif skin:
             palette = skinning_matrices(self.rig.skeleton, model)
             if self.skinned_normals:

@@ -27,6 +27,7 @@ from .joint_panel import InfoPanel, JointPanel
 from .jobs import JobsMixin
 from .rebind import RestRebind
 from .weight_brush import install_weight_brush
+from .proxy_view import ProxyView
 from .weight_tools import install_weight_tools
 
 __all__ = ["MainWindow", "default_rig"]
@@ -90,6 +91,8 @@ class MainWindow(MenusMixin, JobsMixin, QtWidgets.QMainWindow):
         IK chain length of a pose-mode drag.
     interacting : bool
         Whether a gizmo drag is held.
+    proxy_view : ProxyView
+        Draws a big mesh's decimated proxy while it moves, and says so in the status bar.
     """
 
     def __init__(self, rig=None, parent=None):
@@ -120,6 +123,9 @@ class MainWindow(MenusMixin, JobsMixin, QtWidgets.QMainWindow):
         self._load_scene()
         self.weight_brush = install_weight_brush(self)  # issue 10: rigedit/ui/weight_brush.py
         install_weight_tools(self)  # DQS toggle, recompute method, deform flag
+        # a big mesh is drawn as its decimated proxy while it moves (issue 12)
+        self.proxy_view = ProxyView(lambda: self.scene, self.document, self.statusBar(),
+                                    self.request_render, lambda: self._weights_view)
         self.autosave = Autosave(self)
         self.error_display = errors_hook.ErrorDisplay(self)
         errors_hook.install(self)
