@@ -10,9 +10,12 @@ actor of today against the forty ``vtkSphereWidget`` s it replaced.
    the one without spheres.
 2. Python per mouse move: moving all spheres onto a new pose (glyph points in place against
    forty ``SetCenter`` calls) and the hover pick of the mouse ray against every sphere.
+3. The look: the view rendered with the glyphs and with the widgets (same pose, camera and
+   everything else), the share of pixels that differ and by how much; ``--save DIR`` writes
+   both images.
 
 Run: ``xvfb-run -a -s "-screen 0 1600x1000x24" .venv/bin/python benchmarks/bench_gizmos.py
-[--size 1280x720] [--rounds 7]``.
+[--size 1280x720] [--rounds 15] [--save DIR]``.
 """
 from __future__ import annotations
 
@@ -55,10 +58,36 @@ def old_widgets(w):
     return widgets
 
 
+def compare_look(w, set_widgets, folder=None):
+    """Pixels of the view with the glyph spheres against the same view with the widgets."""
+    w.plotter.render()
+    glyph = w.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+    w.gizmos.set_visible(False)
+    set_widgets(True)
+    w.plotter.render()
+    widget = w.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+    set_widgets(False)
+    w.gizmos.set_visible(True)
+    w.plotter.render()
+    diff = np.abs(glyph - widget).max(axis=2)
+    changed = diff > 8
+    print("\nthe look: view with glyphs vs with widgets")
+    print(f"  pixels differing by more than 8 levels: {changed.mean():.3%} of the view; "
+          f"their mean difference {diff[changed].mean() if changed.any() else 0:.1f} levels; "
+          f"mean over all pixels {np.abs(glyph - widget).mean():.2f}")
+    if folder:
+        import imageio.v2 as imageio
+
+        Path(folder).mkdir(parents=True, exist_ok=True)
+        imageio.imwrite(Path(folder) / "gizmos-glyphs.png", glyph.astype(np.uint8))
+        imageio.imwrite(Path(folder) / "gizmos-widgets.png", widget.astype(np.uint8))
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--size", default="1280x720", help="editor window size")
     parser.add_argument("--rounds", type=int, default=15)
+    parser.add_argument("--save", help="folder for the two images of the look comparison")
     args = parser.parse_args()
     from PyQt5 import QtWidgets
     from threadpoolctl import threadpool_limits
@@ -121,6 +150,7 @@ def main():
         print(f"  move all spheres onto a pose: glyph points {glyph_ms:.3f} ms, "
               f"40 SetCenter {widget_ms:.3f} ms")
         print(f"  hover pick (mouse ray against {len(heads)} spheres): {pick_ms:.3f} ms")
+        compare_look(w, set_widgets, args.save)
         for s in widgets:
             s.SetEnabled(False)
             s.SetInteractor(None)
