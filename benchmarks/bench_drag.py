@@ -8,7 +8,14 @@
    N mouse moves, release, through the VTK interactor (each move = one IK solve, skinning,
    in-place point update and one render, counted with a render-window observer).
 
-Run: ``xvfb-run -a .venv/bin/python benchmarks/bench_drag.py [RIG] [--size 1280x720]``.
+3. ``--big``: the same window drag on a big character, the quadruped with each triangle
+   split at its centroid twice (540,000 triangles, 270,002 vertices, weights interpolated;
+   ``rigedit.model.subdivide``), twice in turn: as the editor draws it (its decimated proxy
+   while the joint moves, the full mesh on release) and with the proxy turned off (the full
+   mesh every frame); frames/s of each and what the status bar said.
+
+Run: ``xvfb-run -a .venv/bin/python benchmarks/bench_drag.py [RIG] [--size 1280x720]
+[--big]``.
 """
 from __future__ import annotations
 
@@ -66,13 +73,31 @@ def model_step(rig, steps=300):
     return np.array(times) * 1e3, np.array(ik) * 1e3
 
 
-def window_drag(rig, size, moves=120):
+def big_rig(rig, levels=2):
+    """``rig`` with every triangle split at its centroid ``levels`` times (3**levels times
+    the triangles), weights interpolated, same skeleton and clips."""
+    from rigedit import Rig
+    from rigedit.model.subdivide import subdivide_centroid
+
+    b = rig.binding
+    v, f, idx, w = subdivide_centroid(rig.vertices, rig.faces, b.indices, b.weights,
+                                      len(rig.skeleton), levels=levels)
+    return Rig(rig.skeleton, v, f, idx, w, clips=rig.clips, name=f"{rig.name} x{3 ** levels}")
+
+
+def window_drag(rig, size, moves=120, proxy=True, window=None):
+    """Frames/s of a real drag in the editor window, renders per move, the scene update's
+    ms, undo steps, and the status bar's proxy label during the drag and after it."""
     from PyQt5 import QtWidgets
 
     from rigedit.ui import MainWindow
 
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication([])
-    w = MainWindow(rig)
+    w = window or MainWindow(rig)
+    if not proxy:
+        w.proxy_view.min_faces = 10 ** 12
+        w.scene.detach_proxy()
+        w.proxy_view.attach()
     w.resize(*size)
     w.show()
     for _ in range(10):
@@ -98,8 +123,13 @@ def window_drag(rig, size, moves=120):
         app.processEvents()
     elapsed = time.perf_counter() - t0
     n_renders = renders[0]
+    during = w.proxy_view.label.text().strip() if w.proxy_view.label.isVisible() else "-"
     iren.InvokeEvent("LeftButtonReleaseEvent")
     app.processEvents()
+    settle = time.perf_counter() + 2.0
+    while w.scene.proxy_shown and time.perf_counter() < settle:
+        app.processEvents()
+    after = w.proxy_view.label.text().strip() if w.proxy_view.label.isVisible() else "-"
     # Scene update alone (points into VTK), for the breakdown.
     model = rig.joint_matrices(w.document.pose)
     t1 = time.perf_counter()
@@ -108,7 +138,7 @@ def window_drag(rig, size, moves=120):
     scene_ms = (time.perf_counter() - t1) / 50 * 1e3
     steps = len(w.document.undo_stack)
     w.close()
-    return moves / elapsed, n_renders / moves, scene_ms, steps
+    return moves / elapsed, n_renders / moves, scene_ms, steps, (during, after)
 
 
 def main():
@@ -116,8 +146,14 @@ def main():
     parser.add_argument("rig", nargs="?")
     parser.add_argument("--size", default="1280x720", help="window size")
     parser.add_argument("--no-window", action="store_true")
+    parser.add_argument("--big", action="store_true",
+                        help="also drag the quadruped split to 540k triangles")
+    parser.add_argument("--rounds", type=int, default=2, help="rounds of the --big drags")
     args = parser.parse_args()
     import rigedit
+    from rigedit.model import skinning_kernels
+
+    skinning_kernels.load()   # as app.py does half a second after start
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -130,11 +166,32 @@ def main():
               f"p95 {np.percentile(total, 95):.2f} ms  (IK alone {np.median(ik):.2f} ms)")
         if not args.no_window:
             size = tuple(int(v) for v in args.size.split("x"))
-            fps, per_move, scene_ms, steps = window_drag(rig, size)
+            fps, per_move, scene_ms, steps, _ = window_drag(rig, size)
             print(f"scene update (points + bones into VTK): {scene_ms:.2f} ms")
             print(f"window drag at {args.size} under {os.environ.get('DISPLAY', '?')}: "
                   f"{fps:.1f} frames/s, {per_move:.2f} renders per mouse move, "
                   f"{steps} undo step(s)")
+        if args.big and not args.no_window:
+            t0 = time.perf_counter()
+            big = big_rig(rig)
+            print(f"\nbig character: {len(big.vertices):,} vertices, {len(big.faces):,} "
+                  f"triangles (built in {time.perf_counter() - t0:.1f} s)")
+            rows = {True: [], False: []}
+            for _ in range(args.rounds):
+                for proxy in (True, False):
+                    t0 = time.perf_counter()
+                    res = window_drag(big, size, moves=40, proxy=proxy)
+                    rows[proxy].append((res[0], res[1], res[4], time.perf_counter() - t0))
+            for proxy, label in ((True, "as the editor draws it (proxy while moving)"),
+                                 (False, "full mesh every frame (proxy off)")):
+                fps = [r[0] for r in rows[proxy]]
+                print(f"  {label:<45} {max(fps):5.1f} frames/s (rounds "
+                      f"{', '.join(f'{f:.1f}' for f in fps)}; "
+                      f"{np.mean([r[1] for r in rows[proxy]]):.2f} renders/move; window "
+                      f"open to close {min(r[3] for r in rows[proxy]):.1f} s)")
+                print(f"      status bar during the drag: {rows[proxy][0][2][0]!r}; "
+                      f"after the release: {rows[proxy][0][2][1]!r}")
+            print(f"load average: {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":

@@ -273,18 +273,23 @@ def open_bare(app, rig, render_size, camera):
     return win, plotter, mesh
 
 
+def skin_into(rig, mesh, palette):
+    """Skin positions and normals in one pass and write them into ``mesh`` in place."""
+    pts, nrm = rig.binding.skin_with_normals(palette)
+    mesh.points[:] = pts
+    mesh.point_data["Normals"][:] = nrm
+    mesh.GetPointData().GetNormals().Modified()
+    mesh.GetPoints().Modified()
+    mesh.Modified()
+
+
 def bare_frames(rig, plotter, mesh, palettes):
     """Median ms of a bare frame (skin positions+normals, copy, render) and of its render."""
     rw = plotter.render_window
     frame, render = [], []
     for p in list(palettes[:3]) + list(palettes):
         t0 = time.perf_counter()
-        pts, nrm = rig.binding.skin_with_normals(p)
-        mesh.points[:] = pts
-        mesh.point_data["Normals"][:] = nrm
-        mesh.GetPointData().GetNormals().Modified()
-        mesh.GetPoints().Modified()
-        mesh.Modified()
+        skin_into(rig, mesh, p)
         t1 = time.perf_counter()
         rw.Render()
         t2 = time.perf_counter()
@@ -306,12 +311,7 @@ def bare_qt_frames(app, rig, plotter, mesh, palettes):
         if k == 3:
             count[0] = 0
         t0 = time.perf_counter()
-        pts, nrm = rig.binding.skin_with_normals(p)
-        mesh.points[:] = pts
-        mesh.point_data["Normals"][:] = nrm
-        mesh.GetPointData().GetNormals().Modified()
-        mesh.GetPoints().Modified()
-        mesh.Modified()
+        skin_into(rig, mesh, p)
         plotter.update()
         app.processEvents()
         frame.append(time.perf_counter() - t0)

@@ -134,7 +134,8 @@ def test_a_replaced_binding_gets_its_own_rest_normals(plotter, quadruped):
     try:
         # every vertex follows the root only: posed normals are the rest ones turned rigidly
         rig.binding = SkinBinding(old.rest_vertices, np.zeros((len(rig.vertices), 4), np.int32),
-                                  np.tile([1.0, 0, 0, 0], (len(rig.vertices), 1)), len(rig.skeleton))
+                                  np.tile([1.0, 0, 0, 0], (len(rig.vertices), 1)),
+                                  len(rig.skeleton))
         pose = rig.rest_pose()
         pose.set_euler(0, [0, 90, 0], degrees=True)
         scene.update(pose)
