@@ -216,3 +216,21 @@ def test_record_video_from_the_editor(window, tmp_path, qtbot):
     window.timeline.set_time(0.5)
     assert np.abs(np.array(window.scene.mesh.points) - before).max() > 0.05
     assert window.export_video_action.isEnabled()
+
+
+def test_opening_a_rig_with_other_joints_shows_its_first_clip_pose(window, qtbot):
+    # The timeline answers "rig" before the window rebuilds its scene: a "pose" event then
+    # skinned the old mesh with the new rig's joint count (an error, and no new rig shown).
+    import rigedit
+
+    w = window
+    w.files.open_folder(str(rigedit.resolve_rig_path("humanoid")))
+    qtbot.waitUntil(lambda: w.job is None, timeout=60000)
+    doc = w.document
+    assert w.last_error is None, w.last_error
+    assert len(doc.skeleton) != len(_rig().skeleton) and doc.current_clip is not None
+    shown = np.asarray(w.scene.mesh.points)
+    expected = doc.rig.skin(doc.clips[doc.current_clip].sample(doc.time))
+    assert shown.shape == expected.shape
+    assert np.abs(shown - expected).max() < 1e-4
+    assert not np.allclose(expected, doc.rig.vertices, atol=1e-4)   # not the rest pose

@@ -260,6 +260,15 @@ class TimelineDock(QtWidgets.QDockWidget):
         clip.sample(self.time, out=self._pose)
         self.document.set_pose(self._pose)
 
+    def _sample_new_rig(self):
+        """A new rig shows its clip's pose at the current time. Written into the document's
+        pose without a "pose" event: listeners after this one (the window) still hold the old
+        rig until the same "rig" event reaches them, and they then show the document's pose
+        (a "pose" event now would skin the old mesh with the new rig's joints)."""
+        clip = self.clip
+        if clip is not None and not self.document.dragging:
+            clip.sample(self.time, out=self.document.pose)
+
     # ================================================================== document events
     def _on_document(self, event, **info):
         if event == "time":
@@ -270,7 +279,9 @@ class TimelineDock(QtWidgets.QDockWidget):
                 self.pause()
                 self._pose = None
             self._reload_clips()
-            if self._resample:
+            if self._resample and event == "rig":
+                self._sample_new_rig()
+            elif self._resample:
                 self._show_clip_pose()
             self._resample = True
         elif event == "selection":
