@@ -35,24 +35,10 @@ def template_path(path):
     return path
 
 
-def _getter(obj, *names):
-    for name in names:
-        if isinstance(obj, dict) and name in obj:
-            return obj[name]
-        if hasattr(obj, name):
-            return getattr(obj, name)
-    return None
-
-
 def describe_report(report):
-    """One line for the status bar from ``rig.autorig_report``: the orientation used (and
-    whether it was guessed) and the time of each stage.
-
-    Parameters
-    ----------
-    report : object
-        Helper A's report dataclass; read by attribute (``up``, ``forward``, ``guessed``,
-        ``seconds``), so an older or newer report with fewer fields still gives a line.
+    """One line for the status bar from ``rig.autorig_report``
+    (:class:`rigedit.rigging.autorig.AutorigReport`): the orientation used and whether it was
+    guessed (and sure), the template clips that came along, and each stage's time.
 
     Returns
     -------
@@ -60,21 +46,24 @@ def describe_report(report):
     """
     if report is None:
         return ""
-    parts = []
-    summary = _getter(report, "orientation_text")
-    if summary:
-        parts.append(str(summary))
-    else:
-        up, fwd = _getter(report, "up"), _getter(report, "forward")
-        guessed = _getter(report, "guessed")
-        if up is not None or fwd is not None:
-            how = "guessed" if guessed else "given"
-            parts.append(f"up {up}, forward {fwd} ({how})")
-    seconds = _getter(report, "seconds") or {}
-    if seconds:
-        total = seconds.get("total", sum(v for k, v in seconds.items() if k != "total"))
-        stages = ", ".join(f"{k} {v:.1f} s" for k, v in seconds.items() if k != "total")
-        parts.append(f"{total:.1f} s ({stages})")
+    from ..rigging.orient import axis_name
+
+    o = report.orientation
+    how = "given" if not o.guessed else ("guessed" if o.sure else
+                                         "guessed, NOT SURE: check it, or choose Up and "
+                                         "Forward in the dialog")
+    parts = [f"up {axis_name(o.up)}, forward {axis_name(o.forward)} ({how})"]
+    left_out = [name for name, how in report.clips.items() if how != "retargeted"]
+    if left_out:
+        parts.append(f"clips left out: {', '.join(left_out)}")
+    seconds = report.seconds
+    # the embedding's own stages ("embedding/search") are inside its total: top level only
+    top = {k: v for k, v in seconds.items()
+           if not k.startswith("embedding/") and k != "total"}
+    if top:
+        total = seconds.get("total", sum(top.values()))
+        parts.append(f"{total:.1f} s (" + ", ".join(f"{k} {v:.1f} s" for k, v in top.items())
+                     + ")")
     return "; ".join(parts)
 
 
