@@ -138,14 +138,50 @@ def test_bent_rest_legs_are_not_copied_as_angles(quad, results):
     assert np.degrees((naive.inv() * got).magnitude()) > 15
 
 
-def test_other_names_need_a_map_and_give_the_same_motion(quad, results, tmp_path):
-    target = variant(quad.skeleton, **VARIANTS["long legs, short neck"], rename=renamed)
-    with pytest.raises(ValueError, match="none of its 40 joints maps onto"):
-        retarget_result(quad, "walk", target)
+@pytest.mark.parametrize("vname", list(VARIANTS))
+def test_other_names_map_by_the_trees_shape_or_a_map(quad, results, vname):
+    """Unrelated names (``Q_ForeHoof.l``): the map found from the trees' shape pairs every
+    joint below the ground-level root as the names say, and gives the same motion as equal
+    names; so does a given map."""
+    target = variant(quad.skeleton, **VARIANTS[vname], rename=renamed)
+    same = results(vname, "walk")
+    res = retarget_result(quad, "walk", target)
+    assert res.mapping == {n: renamed(n) for n in quad.skeleton.names if n != "root"}
+    assert np.abs(res.mats - same.mats).max() < 1e-9
     mapping = {n: renamed(n) for n in quad.skeleton.names}
     res = retarget_result(quad, "walk", target, map=mapping)
-    same = results("long legs, short neck", "walk")
     assert np.abs(res.mats - same.mats).max() < 1e-9
+
+
+def test_tree_map_pairs_a_shorter_neck_and_no_antlers(quad):
+    """Another build of the same animal: two neck joints instead of three, no antlers, no
+    tail; the neck's ends pair, the missing joints are left out, the legs pair by side."""
+    from rigedit.model import Skeleton
+    from rigedit.rigging.tree_map import tree_map
+
+    sk = quad.skeleton
+    drop = {"neck_2", "tail_1", "tail_2", "tail_3", "tail_4"} | {
+        n for n in sk.names if n.startswith("antler")}
+    keep = [j for j, n in enumerate(sk.names) if n not in drop]
+    pts = sk.bind_matrices[:, :3, 3]
+    parents, names = [], []
+    for j in keep:
+        p = sk.parents[j]
+        while p >= 0 and sk.names[p] in drop:
+            p = sk.parents[p]
+        parents.append(keep.index(p) if p >= 0 else -1)
+        names.append("B" + sk.names[j].upper())
+    trans = np.array([pts[j] - (pts[keep[parents[i]]] if parents[i] >= 0 else 0)
+                      for i, j in enumerate(keep)])
+    other = Skeleton(names, parents, trans, tails=sk.tails[keep])
+    src = calibrate(sk, [], "quadruped", LegCalibration)
+    tgt = calibrate(other, [], "other", LegCalibration)
+    m = tree_map(src, tgt)
+    for n in ("pelvis", "spine_2", "spine_3", "neck_1", "head", "jaw", "ear_L", "ear_R",
+              "scapula_L", "fore_cannon_R", "hind_thigh_L", "hind_hoof_R"):
+        assert m[n] == "B" + n.upper(), (n, m.get(n))
+    assert "neck_3" not in m or m["neck_3"] == "BNECK_3"
+    assert not set(m) & drop
 
 
 def _run(*argv):
@@ -181,13 +217,25 @@ def test_cli_json_map_onto_renamed_quadruped_and_bad_input(quad, tmp_path):
     direct = retarget_result(quad, "walk", variant(quad.skeleton,
                                                    **VARIANTS["big (x1.5), short legs"]))
     assert np.allclose(clip.sample(0.3).rotation, direct.clip.sample(0.3).rotation, atol=1e-6)
-    # a quadruped BVH with other joint names: nothing maps onto the bundled quadruped
+    # that clip as a BVH of other joint names maps back onto the quadruped by shape
     moving = Rig(target.skeleton, np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64),
                  clips={"walk": clip})
     bvh = tmp_path / "other_walk.bvh"
     moving.save(bvh)
+    p = _run("retarget", bvh, "--to", "quadruped", "-o", tmp_path / "back.json")
+    assert p.returncode == 0, p.stderr
+    assert "Q_HindShin.r -> hind_shin_R" in p.stdout
+    # a humanoid BVH of other joint names: two legs against four, nothing maps
+    hum = rigedit.load_rig("humanoid")
+    hsk = hum.skeleton
+    bip = type(hsk)([f"Bip_{n}" for n in hsk.names], hsk.parents, hsk.rest_translation,
+                    tails=hsk.tails)
+    walker = Rig(bip, np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64))
+    walker.clips["walk"] = rigedit.retarget(hum, "walk", walker)
+    bvh = tmp_path / "human_walk.bvh"
+    walker.save(bvh)
     _one_error(_run("retarget", bvh, "--to", "quadruped", "-o", tmp_path / "a.json"),
-               str(bvh), "none of its", "joints maps onto", "--map")
+               str(bvh), "none of its", "joints maps onto", "legs differ", "--map")
     # a target without legs: the quadruped cut at the shoulders and hips
     sk = quad.skeleton
     keep = [j for j, n in enumerate(sk.names) if not n.startswith(("fore_", "hind_"))]

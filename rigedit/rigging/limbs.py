@@ -22,7 +22,8 @@ import numpy as np
 from .calibrate import foot_points, unit
 from .name_map import _KNEE, bend_index
 
-__all__ = ["Leg", "find_legs", "LegCalibration", "LEG_GROUPS", "FOOT_TOL", "BRANCH_HEIGHT"]
+__all__ = ["Leg", "find_legs", "LegCalibration", "leg_counts", "leg_contacts", "ground",
+           "LEG_GROUPS", "FOOT_TOL", "BRANCH_HEIGHT"]
 
 FOOT_TOL = 0.1
 BRANCH_HEIGHT = 0.3
@@ -207,3 +208,58 @@ class LegCalibration:
         if j in between:
             return "spine"
         return "head" if self.chest in up else "tail"
+
+
+def leg_counts(cal):
+    hind = sum(cal.skeleton.parents[leg.chain[0]] == cal.hips for leg in cal.legs)
+    return f"{hind} legs from the hips and {len(cal.legs) - hind} from elsewhere"
+
+
+def leg_contacts(src, tgt, inverse, contact):
+    """Each target leg's contact mask, from the source leg its lowest mapped joint lies in.
+
+    Returns
+    -------
+    contact : (F, len(tgt.legs)) bool
+        All False for a leg no source leg maps onto (it is still kept above the floor).
+    source_points : list of int
+        The source foot leaf per target leg (the first source leaf for an unmatched leg,
+        which never touches in ``contact``).
+    source_legs : list of int or None
+        The index of the source leg per target leg.
+    """
+    out = np.zeros((len(contact), len(tgt.legs)), dtype=bool)
+    points = [src.contacts[0]] * len(tgt.legs)
+    legs = [None] * len(tgt.legs)
+    for i, leg in enumerate(tgt.legs):
+        mapped = [inverse[j] for j in reversed(leg.chain) if j in inverse]
+        for k, s_leg in enumerate(src.legs):
+            if mapped and mapped[0] in s_leg.chain:
+                out[:, i], points[i], legs[i] = contact[:, k], s_leg.contact, k
+                break
+    return out, points, legs
+
+
+def ground(src, tgt, smats, raw, s_legs, scale):
+    """Where the target's feet stand: the vertical shift that puts its lowest foot point on
+    its floor as often as the source's stands on the source's ground (both: the 5th
+    percentile over the frames of the lowest foot point, so that a rest with other foot
+    angles does not sink or lift the motion), and the height of each target foot leaf during
+    contacts, before the shift: its foot's lowest point as high above the floor as the
+    source foot's, scaled, the leaf above that point as the foot's turn puts it.
+
+    Returns
+    -------
+    shift : float
+    heights : (F, len(tgt.legs)) float64
+    """
+    s_ground = np.percentile(src.foot_points(smats)[..., 1].min(axis=1), 5)
+    shift = tgt.floor - np.percentile(tgt.foot_points(raw)[..., 1].min(axis=1), 5)
+    heights = raw[:, tgt.contacts, 1, 3].copy()
+    for i, (leg, k) in enumerate(zip(tgt.legs, s_legs)):
+        if k is None:
+            continue
+        t_low = foot_points(tgt.skeleton, leg.foot, raw)[..., 1].min(axis=1)
+        s_low = foot_points(src.skeleton, src.legs[k].foot, smats)[..., 1].min(axis=1)
+        heights[:, i] += tgt.floor - shift + scale * (s_low - s_ground) - t_low
+    return shift, heights

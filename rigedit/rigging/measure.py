@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from .contacts import runs
+from .transfer import end_points
 
 __all__ = ["direction_errors", "foot_slip", "lowest_foot", "target_foot_points",
            "source_foot_points"]
@@ -27,8 +28,6 @@ def direction_errors(result, mats=None):
         Group -> mean angle (NaN for a group without bones); ``"worst"`` -> the largest
         single-frame angle outside the feet.
     """
-    from .retarget import _end_points
-
     mats = result.mats if mats is None else mats
     tgt = result.target_calibration
     per, worst = {g: [] for g in tgt.groups}, 0.0
@@ -36,8 +35,8 @@ def direction_errors(result, mats=None):
         g = tgt.group(j)
         if g is None:
             continue
-        vt = _end_points(mats, t_spec) - mats[:, j, :3, 3]
-        vs = _end_points(result.source_mats, s_spec) - result.source_mats[:, s, :3, 3]
+        vt = end_points(mats, t_spec) - mats[:, j, :3, 3]
+        vs = end_points(result.source_mats, s_spec) - result.source_mats[:, s, :3, 3]
         cos = np.sum(vt * vs, axis=1) / (np.linalg.norm(vt, axis=1) * np.linalg.norm(vs, axis=1))
         ang = np.degrees(np.arccos(np.clip(cos, -1, 1)))
         per[g].append(ang.mean())

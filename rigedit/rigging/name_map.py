@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import RigFileError
 
 __all__ = ["normalise_name", "find_slots", "auto_map", "name_pairs", "load_map", "save_map",
-           "bend_index", "LIMB_SLOTS"]
+           "bend_index", "interior_map", "LIMB_SLOTS"]
 
 LIMB_SLOTS = ("clavicle", "upper_arm", "forearm", "hand", "thigh", "shin", "foot", "toe")
 _NOISE = {"joint", "jnt", "bone", "skeleton", "def", "bip01", "bip001", "mixamorig", "end", "j",
@@ -237,7 +237,7 @@ def _side_of(skeleton, part):
     return sides.pop() if len(sides) == 1 else None
 
 
-def _interior_map(src_chain, src_points, tgt_chain, tgt_points):
+def interior_map(src_chain, src_points, tgt_chain, tgt_points):
     """Pair the interior joints of two chains (ends excluded) by nearest fraction of length,
     one to one and in order."""
     def fractions(chain, points):
@@ -281,7 +281,7 @@ def auto_map(src_skeleton, src_points, tgt_skeleton, tgt_points, src_what="sourc
     t_slots, t_chains, _ = find_slots(tgt_skeleton, tgt_points, tgt_what)
     pairs = [(s_slots[k], t_slots[k]) for k in t_slots if k in s_slots]
     for name in ("spine", "neck"):
-        pairs += _interior_map(s_chains[name], src_points, t_chains[name], tgt_points)
+        pairs += interior_map(s_chains[name], src_points, t_chains[name], tgt_points)
     mapping = {src_skeleton.names[a]: tgt_skeleton.names[b] for a, b in pairs}
     mapping.update(name_pairs(src_skeleton, tgt_skeleton, mapping))
     return mapping
