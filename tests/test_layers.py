@@ -18,7 +18,7 @@ def test_pure_packages_import_no_gui_modules():
 
 
 def test_render_never_imports_qt():
-    code = ("import sys, rigedit.render, rigedit.render.recorder\n"
+    code = ("import sys, rigedit.render, rigedit.render.recorder, rigedit.render.gizmos\n"
             "print(','.join(m for m in sys.modules if m.split('.')[0] in ('PyQt5', 'pyvistaqt')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.strip()
