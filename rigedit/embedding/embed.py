@@ -1,8 +1,9 @@
 """``embed_skeleton``: a template skeleton fitted inside a mesh (Baran and Popovic 2007).
 
-Stages (each timed in ``Embedding.seconds``): the distance field, spheres on the medial
-surface, the graph on their centres, the reduced template, the discrete best-first search,
-the continuous refinement, and the placement of every template joint.
+Stages (each timed in ``Embedding.seconds``): the reduced template, the distance field,
+the medial surface and the spheres on it, the graph on their centres, the discrete
+best-first search, the continuous refinement (:mod:`rigedit.embedding.fit`) and the
+placement of the carried joints.
 """
 from __future__ import annotations
 
@@ -12,10 +13,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .distance import distance_field
+from .fit import W_SCALE_FIRM, W_SCALE_WEAK, fit_joints
 from .graph import medial_graph
 from .medial import medial_cells, pack_spheres
-from .place import place_joints
-from .refine import refine
+from .place import place_carried, place_chains
 from .search import discrete_embedding
 from .template import reduce_template
 
@@ -84,7 +85,7 @@ def _frame(vertices, faces):
             "plane_x": plane}
 
 
-def embed_skeleton(vertices, faces, template, progress=None):
+def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None):
     """Embed a template skeleton in a closed (or nearly closed) triangle mesh.
 
     Parameters
@@ -96,6 +97,10 @@ def embed_skeleton(vertices, faces, template, progress=None):
         Its rest pose gives the template's joint positions.
     progress : callable(fraction), optional
         Called with the fraction done (0..1); may raise to cancel (the exception propagates).
+    template_mesh : ((V, 3) float64, (F, 3) int), optional
+        The template's own mesh at its rest pose (a bundled character's, a .glb's). With it
+        the scale comes from the two heights and the template's ground is known; without it
+        both are estimated from the skeleton alone.
 
     Returns
     -------
@@ -120,7 +125,7 @@ def embed_skeleton(vertices, faces, template, progress=None):
     report(0.0)
     vertices, faces = _check_mesh(vertices, faces)
     try:
-        reduced = stage("template", 0.02, reduce_template, template)
+        reduced = stage("template", 0.02, reduce_template, template, template_mesh)
     except ValueError as exc:
         raise EmbeddingError(str(exc)) from None
     field_ = stage("distance field", 0.3, distance_field, vertices, faces)
@@ -130,8 +135,12 @@ def embed_skeleton(vertices, faces, template, progress=None):
     spheres = stage("spheres", 0.45, pack_spheres, *cells, field_.h)
     graph = stage("graph", 0.55, medial_graph, field_, *spheres)
     frame = _frame(vertices, faces)
+    frame["cell"] = field_.h
     kept = reduced.rest[~reduced.carried]
-    scale = frame["height"] / max(1.15 * np.ptp(kept[:, 1]), 1e-12)
+    if np.isfinite(reduced.height):
+        scale = frame["height"] / max(reduced.height, 1e-12)
+    else:
+        scale = frame["height"] / max(np.max(kept[:, 1]) - reduced.floor, 1e-12) / 1.1
     if len(graph.points) < len(reduced.joints):
         raise EmbeddingError(
             f"no place found for the template's {reduced.label(template, 1)}: the mesh has "
@@ -140,13 +149,6 @@ def embed_skeleton(vertices, faces, template, progress=None):
     t0 = time.perf_counter()
     sub = (lambda f: report(0.55 + 0.25 * f)) if progress else None
     found = discrete_embedding(graph, reduced, frame, scale, sub)
-    if found.vertex is not None:
-        # Re-scale from the found bones (the first guess comes from the height alone).
-        fitted = _fitted_scale(graph, reduced, found.vertex)
-        if fitted and abs(np.log(fitted / scale)) > 0.05:
-            again = discrete_embedding(graph, reduced, frame, fitted, sub)
-            if again.vertex is not None:
-                found, scale = again, fitted
     seconds["search"] = time.perf_counter() - t0
     report(0.8)
     if found.vertex is None:
@@ -157,22 +159,14 @@ def embed_skeleton(vertices, faces, template, progress=None):
     positions[ok] = graph.points[found.vertex[ok]]
     paths = [None] + [graph.points[graph.path(found.vertex[reduced.parent[r]], found.vertex[r])]
                       if ok[r] else None for r in range(1, len(ok))]
-    positions, scale = stage("refinement", 0.95, refine, field_, reduced, positions, scale, frame)
-    out = stage("placement", 1.0, place_joints, reduced, positions, scale, paths)
+    hold = W_SCALE_FIRM if np.isfinite(reduced.height) else W_SCALE_WEAK
+    chains = place_chains(reduced, positions, paths)
+    out, scale = stage("refinement", 0.95, fit_joints, field_, reduced, chains, scale,
+                       frame["floor"], hold)
+    out = stage("placement", 1.0, place_carried, reduced, out, scale)
     placed_mask = np.zeros(len(out), dtype=bool)
     for r in np.flatnonzero(ok):
         placed_mask[reduced.chains[r][1:] if r else [reduced.joints[0]]] = True
     placed = [template.names[j] for j in np.flatnonzero(placed_mask)]
     return Embedding(out, seconds, float(found.cost), placed, float(scale),
                      np.c_[graph.points, graph.radii])
-
-
-def _fitted_scale(graph, reduced, vertex):
-    ratios = []
-    for r in range(1, len(vertex)):
-        a, b = vertex[reduced.parent[r]], vertex[r]
-        if a >= 0 and b >= 0:
-            chord = np.linalg.norm(reduced.rest[reduced.joints[r]]
-                                   - reduced.rest[reduced.joints[reduced.parent[r]]])
-            ratios.append(np.linalg.norm(graph.points[b] - graph.points[a]) / max(chord, 1e-12))
-    return float(np.median(ratios)) if ratios else None

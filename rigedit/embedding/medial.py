@@ -18,6 +18,12 @@ __all__ = ["medial_cells", "pack_spheres"]
 MEDIAL_COS = 0.42
 #: Cells shallower than this many cell sizes are skipped: their nearest point is noisy.
 MIN_DEPTH_CELLS = 0.9
+#: A medial cell's two nearest surface points (its own and a neighbour's) must be at least
+#: this fraction of its depth apart (the lambda-medial axis of Chazal and Lieutier): this
+#: prunes the medial branches that run into every small bump and crease of the surface,
+#: which would draw the search off the middle of the body, and keeps the axis of any part
+#: whose two sides are both in view (a limb: 2 depths apart).
+SEPARATION = 1.0
 
 
 def medial_cells(field):
@@ -38,7 +44,9 @@ def medial_cells(field):
     deep = field.inside & (depth > MIN_DEPTH_CELLS * h)
     idx = np.argwhere(deep)
     pts = field.points(idx)
-    grad = pts - field.nearest[tuple(idx.T)]
+    near = field.nearest[tuple(idx.T)]
+    dep = depth[tuple(idx.T)]
+    grad = pts - near
     grad /= np.maximum(np.linalg.norm(grad, axis=1, keepdims=True), 1e-300)
     full = np.zeros(depth.shape + (3,))
     full[tuple(idx.T)] = grad
@@ -52,9 +60,12 @@ def medial_cells(field):
             g = np.zeros_like(grad)
             g[ok] = full[tuple(nb[ok].T)]
             inside_nb = np.zeros(len(idx), dtype=bool)
-            inside_nb[ok] = field.inside[tuple(nb[ok].T)]
+            inside_nb[ok] = deep[tuple(nb[ok].T)]
             cos = np.einsum("ij,ij->i", grad, g)
-            medial |= inside_nb & (cos < MEDIAL_COS)
+            near_nb = np.zeros_like(grad)
+            near_nb[ok] = field.nearest[tuple(nb[ok].T)]
+            apart = np.linalg.norm(near_nb - near, axis=1)
+            medial |= inside_nb & (cos < MEDIAL_COS) & (apart > SEPARATION * dep)
     return pts[medial], depth[tuple(idx[medial].T)]
 
 

@@ -16,10 +16,12 @@ import numpy as np
 
 __all__ = ["bone_costs", "joint_costs", "mirror_cost", "W_CARRY", "SEPARATE_RATIO"]
 
-#: Bone length, as (log ratio)^2 of the path length to the template chain's length and of
-#: the chord to the template chord. 3 makes a bone 25% too long or short cost ~0.3 per
-#: measure: proportions vary between characters (short legs, long arms) more than that.
+#: Bone length, as twice the (log ratio)^2 of the chord to the template chord (times the
+#: scale): 3 makes a bone 25% too long or short cost ~0.3: proportions vary between
+#: characters (short legs, long arms) by about that much.
 W_LENGTH = 3.0
+#: Allowed excess of a path's detour (log of path over chord) over the template chain's.
+DETOUR = 0.15
 #: Bone direction, times (1 - cos) of the angle to the template chord: 0.6 for 45 degrees
 #: (an A-pose arm against a T-pose template, still acceptable), 2 for a right angle, 4 for
 #: a bone pointing backwards (a leg going up).
@@ -32,7 +34,7 @@ W_HEIGHT = 1.0
 W_MIRROR = 0.5
 #: Price of leaving an optional branch (antlers, a tail) unembedded: higher than a fair fit
 #: (a few tenths) and lower than a forced, contorted one.
-W_CARRY = 2.0
+W_CARRY = 0.5
 #: Two limb ends that the template keeps far apart along the tree (the feet: the tree path
 #: through the hips is many times their distance) must be separated in the mesh too: their
 #: graph path must be at least this much longer than their distance. A blob fails here.
@@ -64,8 +66,12 @@ def bone_costs(points, dist, chord, chain_length, scale):
     chord_len = max(float(np.linalg.norm(chord)), 1e-12)
     with np.errstate(divide="ignore", invalid="ignore"):
         cos = np.einsum("abk,k->ab", d, chord / chord_len) / length
-        cost = W_LENGTH * (np.log(dist / (scale * chain_length)) ** 2
-                           + np.log(length / (scale * chord_len)) ** 2)
+        # The chord carries the length; the path (through the inside) may be longer than the
+        # chord only as much as the template chain is longer than its chord, give or take:
+        # beyond that the bone wanders through another part (a hand reached via the hips).
+        detour = np.log(dist / length) - np.log(chain_length / chord_len)
+        cost = W_LENGTH * (2.0 * np.log(length / (scale * chord_len)) ** 2
+                           + np.maximum(detour - DETOUR, 0.0) ** 2)
         cost += W_DIRECTION * (1.0 - cos)
     cost[~np.isfinite(cost)] = np.inf
     np.fill_diagonal(cost, np.inf)

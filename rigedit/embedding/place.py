@@ -7,7 +7,7 @@
   chain bends (a crouch, a bent elbow), ``bend`` pulls each inner joint to the point at
   the same fraction of length along the chain's path through the medial graph.
 * Carried joints (short tips, a non-deforming root, unembedded optional branches) keep
-  their template offset from the nearest placed ancestor, turned like that ancestor's chain
+  their template offset from the nearest placed ancestor, turned like that ancestor's bone
   and scaled by the global scale; a root above everything follows the reduced root.
 """
 from __future__ import annotations
@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-__all__ = ["least_rotation", "place_joints"]
+__all__ = ["least_rotation", "place_chains", "place_carried"]
 
 
 def least_rotation(a, b):
@@ -43,16 +43,14 @@ def _along(polyline, fractions):
                      for d in range(3)], axis=1)
 
 
-def place_joints(template, reduced, scale, paths=None, bend=0.5):
-    """Positions of every template joint.
+def place_chains(template, reduced, paths=None, bend=0.5):
+    """Positions of the joints of the embedded chains (reduced joints and inner ones).
 
     Parameters
     ----------
     template : ReducedTemplate
     reduced : (R, 3) float64
         Embedded reduced joints, NaN rows where carried.
-    scale : float
-        Mesh units per template unit.
     paths : list of (P, 3) float64 or None, optional
         For each reduced joint, the polyline of its embedded chain (parent to joint).
     bend : float
@@ -61,11 +59,10 @@ def place_joints(template, reduced, scale, paths=None, bend=0.5):
     Returns
     -------
     (J, 3) float64
+        NaN rows for the joints left to :func:`place_carried`.
     """
     rest = template.rest
-    n = len(rest)
-    out = np.full((n, 3), np.nan)
-    turn = [None] * n
+    out = np.full((len(rest), 3), np.nan)
     for r, j in enumerate(template.joints):
         if np.all(np.isfinite(reduced[r])):
             out[j] = reduced[r]
@@ -74,30 +71,56 @@ def place_joints(template, reduced, scale, paths=None, bend=0.5):
             continue
         chain = template.chains[r]
         a, b = chain[0], chain[-1]
+        inner = chain[1:-1]
+        if not inner:
+            continue
         rot = least_rotation(rest[b] - rest[a], out[b] - out[a])
         k = np.linalg.norm(out[b] - out[a]) / max(np.linalg.norm(rest[b] - rest[a]), 1e-12)
-        inner = chain[1:-1]
-        if inner:
-            mapped = out[a] + k * rot.apply(rest[inner] - rest[a])
-            if paths is not None and paths[r] is not None and len(paths[r]) > 2 and bend > 0:
-                bones = np.linalg.norm(np.diff(rest[chain], axis=0), axis=1)
-                frac = np.cumsum(bones)[:-1] / max(bones.sum(), 1e-12)
-                mapped = (1.0 - bend) * mapped + bend * _along(paths[r], frac)
-            out[inner] = mapped
-        for j in chain[1:]:
-            turn[j] = rot
+        mapped = out[a] + k * rot.apply(rest[inner] - rest[a])
+        if paths is not None and paths[r] is not None and len(paths[r]) > 2 and bend > 0:
+            bones = np.linalg.norm(np.diff(rest[chain], axis=0), axis=1)
+            frac = np.cumsum(bones)[:-1] / max(bones.sum(), 1e-12)
+            mapped = (1.0 - bend) * mapped + bend * _along(paths[r], frac)
+        out[inner] = mapped
+    return out
+
+
+def place_carried(template, positions, scale):
+    """Fill in the carried joints from the placed ones.
+
+    Each keeps its template offset from its nearest placed ancestor, scaled, and turned like
+    that ancestor's own bone (the least rotation from its template bone to its placed bone);
+    a joint above every placed one (a ground-level root) keeps its offset from the reduced
+    root, unturned.
+
+    Parameters
+    ----------
+    template : ReducedTemplate
+    positions : (J, 3) float64
+        NaN rows for the joints to place.
+    scale : float
+
+    Returns
+    -------
+    (J, 3) float64
+    """
+    rest, parents = template.rest, template.parents
+    out = np.array(positions, dtype=np.float64)
+    placed = np.all(np.isfinite(out), axis=1)
     root = template.joints[0]
-    for j in range(n):
-        if np.all(np.isfinite(out[j])):
+    turn = {}
+    for j in range(len(rest)):
+        if placed[j]:
             continue
-        p = template.parents[j]
-        while p >= 0 and not np.all(np.isfinite(out[p])):
-            p = template.parents[p]
+        p = parents[j]
+        while p >= 0 and not placed[p]:
+            p = parents[p]
         if p < 0:
             out[j] = out[root] + scale * (rest[j] - rest[root])
             continue
-        rot = turn[p] or Rotation.identity()
-        out[j] = out[p] + scale * rot.apply(rest[j] - rest[p])
-        turn[j] = rot
+        if p not in turn:
+            q = parents[p]
+            turn[p] = (least_rotation(rest[p] - rest[q], out[p] - out[q])
+                       if q >= 0 and placed[q] else Rotation.identity())
+        out[j] = out[p] + scale * turn[p].apply(rest[j] - rest[p])
     return out
-

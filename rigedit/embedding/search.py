@@ -25,6 +25,8 @@ __all__ = ["Search", "discrete_embedding"]
 #: Children pushed per expansion (the cheapest by cost plus bound): the others are so much
 #: dearer that the search would never come back to them.
 BRANCH = 48
+#: Radius, in cells, of the thinnest part an optional branch may be embedded in.
+RESOLVED = 2.0
 #: Expansions before the search gives up and keeps the best complete embedding seen.
 MAX_EXPANSIONS = 20000
 
@@ -82,7 +84,8 @@ def discrete_embedding(graph, template, frame, scale, progress=None):
     Parameters
     ----------
     frame : dict
-        ``floor``, ``height`` (of the mesh), ``plane_x`` (its middle plane).
+        ``floor``, ``height`` (of the mesh), ``plane_x`` (its middle plane), ``cell`` (the
+        distance field's cell size).
     scale : float
         Mesh units per template unit.
     progress : callable(fraction), optional
@@ -99,9 +102,14 @@ def discrete_embedding(graph, template, frame, scale, progress=None):
     parent = template.parent
     children = [np.flatnonzero(parent == k) for k in range(r)]
     rest = template.rest[template.joints]
-    deform_floor = float(template.rest[~template.carried, 1].min())
-    unary = np.stack([joint_costs(pts, rest[k, 1], deform_floor, frame["floor"],
+    unary = np.stack([joint_costs(pts, rest[k, 1], template.floor, frame["floor"],
                                   frame["height"], scale) for k in range(r)])
+    # An optional branch goes only where the grid resolves the part (spheres of two cells
+    # or more): on a part one cell thin (antlers, ears) the medial graph is too sparse to
+    # place it, and carrying it from the template is better than a wrong embedding.
+    thin = graph.radii < RESOLVED * frame["cell"]
+    for k in np.flatnonzero(template.optional):
+        unary[k, thin] = np.inf
     pair = [None] + [bone_costs(pts, dist, rest[k] - rest[parent[k]], template.chain_length[k],
                                 scale) for k in range(1, r)]
     # down[k][v]: exact least tree cost of k's subtree with k at v.
@@ -131,7 +139,6 @@ def discrete_embedding(graph, template, frame, scale, progress=None):
     heapq.heapify(heap)
     expansions = 0
     stuck = np.zeros(r, dtype=np.int64)
-    best_full = None
     while heap:
         f, g, assign = heapq.heappop(heap)
         k = len(assign)
@@ -167,10 +174,8 @@ def discrete_embedding(graph, template, frame, scale, progress=None):
             heapq.heappush(heap, (float(fk[v]), float(g + gk[v]), assign + (int(v),)))
         if template.optional[k]:
             heapq.heappush(heap, (g + W_CARRY + h_rest, g + W_CARRY, assign + (-1,)))
-    if best_full is None:
-        return Search(None, np.inf, expansions, failed=int(np.argmax(stuck)) if stuck.any()
-                      else _first_unplaceable(best, template))
-    return best_full
+    return Search(None, np.inf, expansions, failed=int(np.argmax(stuck)) if stuck.any()
+                  else _first_unplaceable(best, template))
 
 
 def _first_unplaceable(best, template):

@@ -1,0 +1,149 @@
+"""Fitting every embedded joint at once: the template's shape against the mesh's middle.
+
+After the search and the refinement of the reduced joints, the joints of the embedded
+chains (reduced and inner ones) are solved together by alternating, as-rigid-as-possible
+fashion:
+
+* shape: every template bone, scaled and turned like its chain (the least rotation taking
+  the template chord onto the embedded chord), should be the bone in the mesh;
+* data: every joint should be at the middle of the mesh's cross-section across its bone
+  (:func:`rigedit.embedding.refine.centre_joints`), with a weight that falls with the
+  part's thickness: the middle of a limb is where its joints are, while the middle of a
+  trunk says little (a quadruped's spine runs along its back, not through its belly), so
+  there the template's shape relative to the limbs decides.
+
+Feet stand on the ground (see ``FEET``). Each round is one small linear least-squares solve (joints x joints); a few rounds settle.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from scipy.spatial.transform import Rotation
+
+from .place import least_rotation
+from .centre import centre_joints
+
+__all__ = ["fit_joints"]
+
+#: Weight of a joint's data term at a thin part, against 1 per template bone: the middle of
+#: a limb is trusted four times as much as the template's bend there (a crouch, an elbow).
+W_DATA = 2.0
+#: Thickness (depth, as a fraction of the scaled template size) at which the data weight
+#: has halved: 2% is a wrist or an ankle on a human, 10% a trunk.
+THIN = 0.005
+ROUNDS = 6
+#: Feet on the ground: joints whose template height above the template's ground is under
+#: this fraction of the joints' height span (ankles, hooves) keep that height above the
+#: mesh's lowest point, times the scale. Limbs say where a joint is across them, not along
+#: them; standing on the ground is what fixes a character's joints vertically.
+FEET = 0.12
+W_FEET = 1.0
+#: Hold of the scale, against all bones together: a scale 1% off costs as much as every
+#: bone 1% off (firm: it came from the template mesh's height), or a tenth of that (weak:
+#: it came from the skeleton's height, good to 10-20%, so the bones may move it).
+W_SCALE_FIRM = 1.0
+W_SCALE_WEAK = 0.1
+
+
+def _chain_of(template, n):
+    """For every template joint, the reduced joint whose chain it ends or lies inside."""
+    owner = np.full(n, -1)
+    for r in range(1, len(template.joints)):
+        owner[template.chains[r][1:]] = r
+    return owner
+
+
+def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK):
+    """Solve the embedded chain joints for shape and middle together.
+
+    Parameters
+    ----------
+    field : DistanceField
+    template : ReducedTemplate
+    positions : (J, 3) float64
+        Every template joint as placed from the reduced joints (NaN where not yet placed).
+    scale : float
+    floor : float
+        The mesh's ground height (its lowest point).
+    hold_scale : float
+        How firmly the scale stays (``W_SCALE_FIRM`` when it came from the template's mesh).
+
+    Returns
+    -------
+    positions : (J, 3) float64
+        The embedded chain joints solved; other rows unchanged.
+    scale : float
+        The scale solved with them.
+    """
+    rest, parents = template.rest, template.parents
+    n = len(rest)
+    owner = _chain_of(template, n)
+    root = template.joints[0]
+    live = np.all(np.isfinite(positions), axis=1) & ~template.carried
+    live &= (owner >= 0) | (np.arange(n) == root)
+    idx = np.flatnonzero(live)
+    if len(idx) < 2:
+        return positions, scale
+    slot = np.full(n, -1)
+    slot[idx] = np.arange(len(idx))
+    bones = [(parents[j], j) for j in idx if parents[j] >= 0 and live[parents[j]]]
+    x = positions[idx].copy()
+    thin = THIN * template.size * scale
+    k = len(idx)
+    pb = np.array([slot[p] for p, _ in bones])
+    cb = np.array([slot[j] for _, j in bones])
+    tb = np.array([rest[j] - rest[p] for p, j in bones])
+    span = np.ptp(rest[idx, 1])
+    # feet: (slot, template height above the template's ground)
+    low = rest[idx, 1] - template.floor
+    # rows of the form  x[i, dim] - coef * scale = value  (weight w)
+    feet = [(i, 1, low[i], floor, W_FEET) for i in np.flatnonzero(low < FEET * span)]
+    scale0 = scale
+    for _ in range(ROUNDS):
+        # each bone turns towards its present direction by how thin its part is: limbs
+        # follow the mesh, the trunk keeps the template's directions (frames are shared)
+        cur = x[cb] - x[pb]
+        mid_depth = np.maximum(field(0.5 * (x[cb] + x[pb])), 0.0)
+        follow = 1.0 / (1.0 + (mid_depth / thin) ** 2)
+        v = np.array([Rotation.from_rotvec(follow[i] * least_rotation(tb[i], cur[i]).as_rotvec())
+                      .apply(tb[i]) for i in range(len(tb))])
+        direction = np.full((k, 3), np.nan)
+        direction[cb] = cur
+        first = [slot[j] for p, j in bones if p == root]
+        if first:
+            direction[slot[root]] = x[first[0]] - x[slot[root]]
+        target = centre_joints(field, x, direction)
+        depth = np.maximum(field(target), 0.0)
+        lam = W_DATA / (1.0 + (depth / thin) ** 2)
+        rows = list(feet)
+        x, scale = _solve(k, pb, cb, v, lam, target, scale0, rows, hold_scale)
+    out = positions.copy()
+    out[idx] = x
+    return out, scale
+
+
+def _solve(k, pb, cb, v, lam, target, scale, extra, hold_scale):
+    """Least squares in joints (k, 3) and scale: bones = scale * v, joints = targets, and
+    ``extra`` rows (slot, dim, coef, value, weight): x[slot, dim] - coef * scale = value."""
+    nb = len(pb)
+    a = np.zeros((3 * nb + 3 * k + 1 + len(extra), 3 * k + 1))
+    rhs = np.zeros(len(a))
+    for d in range(3):
+        rows = 3 * np.arange(nb) + d
+        a[rows, 3 * cb + d] = 1.0
+        a[rows, 3 * pb + d] = -1.0
+        a[rows, -1] = -v[:, d]
+        rows = 3 * nb + 3 * np.arange(k) + d
+        w = np.sqrt(lam)
+        a[rows, 3 * np.arange(k) + d] = w
+        rhs[rows] = w * target[:, d]
+    # hold on the scale, weighed against all the bones at once
+    hold = hold_scale * float(np.linalg.norm(v))
+    a[3 * nb + 3 * k, -1] = hold
+    rhs[3 * nb + 3 * k] = hold * scale
+    for row, (i, dim, coef, value, w) in enumerate(extra, start=3 * nb + 3 * k + 1):
+        a[row, 3 * i + dim] = w
+        a[row, -1] = -w * coef
+        rhs[row] = w * value
+    sol = np.linalg.lstsq(a, rhs, rcond=None)[0]
+    return sol[:-1].reshape(k, 3), float(sol[-1])
