@@ -14,6 +14,8 @@ Quadrupeds (``tests/quadruped_variants.py`` builds the targets from the bundled 
 the same measures per chain group (legs: every bone from the shoulder blade or hip down to
 the hoof; spine: pelvis to the fore legs' branch; head: neck, head, jaw, ears, antlers; tail),
 the slip of each hoof joint during its contacts, and the time of each clip and of all four.
+A target with other joint names is retargeted with a JSON-style map and with the map found
+from the trees' shape (:mod:`rigedit.rigging.tree_map`).
 
 ``--autorig``: also each template's clips onto characters auto-rigged from it
 (``rigedit.autorig(mesh, template, clips=False)``, then :func:`retarget_result` per clip, as
@@ -92,9 +94,10 @@ def quadrupeds(markdown):
     targets = {"itself": (quad, None)}
     targets.update({v: (variant(quad.skeleton, **kw), None) for v, kw in VARIANTS.items()})
     first = next(iter(VARIANTS))
-    targets[f"{first}, other names (map)"] = (
-        variant(quad.skeleton, **VARIANTS[first], rename=renamed),
-        {n: renamed(n) for n in quad.skeleton.names})
+    other = variant(quad.skeleton, **VARIANTS[first], rename=renamed)
+    targets[f"{first}, other names (map)"] = (other,
+                                              {n: renamed(n) for n in quad.skeleton.names})
+    targets[f"{first}, other names (found by shape)"] = (other, None)
     rows, totals = [], []
     for tname, (target, mapping) in targets.items():
         total = 0.0

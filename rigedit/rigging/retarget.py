@@ -226,9 +226,9 @@ def _inverse_map(mapping, src, tgt, source_what, target_what):
                              f"{', '.join(repr(nm) for nm in unknown[:5])}")
     if len(set(mapping.values())) != len(mapping):
         raise ValueError(f"{target_what}: the joint map names a target joint twice")
+    legs = "" if tgt.kind == "humanoid" or legs_agree(src, tgt) else \
+        f"; their legs differ ({leg_counts(src)} against {leg_counts(tgt)})"
     if not mapping:
-        legs = "" if tgt.kind == "humanoid" or legs_agree(src, tgt) else \
-            f", their legs differ ({leg_counts(src)} against {leg_counts(tgt)})"
         raise ValueError(f"{source_what}: none of its {len(ssk)} joints maps onto "
                          f"{target_what}: they are not two humanoids (matched by structure) "
                          f"and share no joint names{legs}; give a joint map (--map)")
@@ -241,6 +241,6 @@ def _inverse_map(mapping, src, tgt, source_what, target_what):
             raise ValueError(f"{source_what}: no joint maps onto the target's {slot} "
                              f"({tsk.names[j]}) in {target_what}" +
                              ("" if tgt.kind == "humanoid" else
-                              f" ({len(mapping)} joint names in common); give a joint map "
+                              f" ({len(mapping)} joints mapped{legs}); give a joint map "
                               f"(--map)"))
     return inverse
