@@ -136,6 +136,13 @@ def test_autorig_opens_new_unsaved_document_in_bind_mode(window, qtbot, monkeypa
     v, _ = load_mesh(small_humanoid_obj)
     assert len(rig.vertices) == len(v)
     assert set(rig.clips) == set(template.clips)
+    # the mesh faced +X: the character shown stands up and faces +Z as every rig does
+    heads = rig.joint_matrices(rig.rest_pose())[:, :3, 3]
+    at = {n: heads[rig.skeleton.index[n]] for n in
+          ("Head", "Hips", "LeftHand", "RightHand", "LeftFoot", "LeftToeBase")}
+    assert at["Head"][1] > at["Hips"][1] > at["LeftFoot"][1]
+    assert at["LeftHand"][0] > at["RightHand"][0]
+    assert at["LeftToeBase"][2] > at["LeftFoot"][2]
     # a new document: unsaved, no undo history, no folder; in bind mode at once
     assert doc.modified and w.windowTitle().endswith("*"), (w.windowTitle(), w.last_error)
     assert rig.path is None
