@@ -22,7 +22,7 @@ import numpy as np
 from .calibrate import foot_points, unit
 from .name_map import _KNEE, bend_index
 
-__all__ = ["Leg", "find_legs", "LegCalibration", "leg_counts", "leg_contacts", "ground",
+__all__ = ["Leg", "find_legs", "LegCalibration", "leg_contacts", "ground",
            "LEG_GROUPS", "FOOT_TOL", "BRANCH_HEIGHT"]
 
 FOOT_TOL = 0.1
@@ -160,8 +160,7 @@ class LegCalibration:
         # leg hanging from the hips down to the foot leaf, and the leaf's height, so that a
         # rest with bent legs does not shrink it; the hips joint sits hip_offset above the
         # legs' top joints.
-        hind = [leg for leg in self.legs if skeleton.parents[leg.chain[0]] == self.hips] \
-            or self.legs
+        hind = [leg for leg in self.legs if self.hind(leg)] or self.legs
         self.hip_height = float(np.mean(
             [np.linalg.norm(np.diff(p[leg.chain], axis=0), axis=1).sum() for leg in hind])
             + np.mean([p[leg.contact, 1] for leg in hind]) - self.joint_floor)
@@ -176,8 +175,8 @@ class LegCalibration:
 
     def _forward(self):
         p, sk = self.points, self.skeleton
-        fore = [leg.contact for leg in self.legs if sk.parents[leg.chain[0]] != self.hips]
-        hind = [leg.contact for leg in self.legs if sk.parents[leg.chain[0]] == self.hips]
+        fore = [leg.contact for leg in self.legs if not self.hind(leg)]
+        hind = [leg.contact for leg in self.legs if self.hind(leg)]
         fwd = np.zeros(3)
         if fore and hind:
             fwd = p[fore].mean(axis=0) - p[hind].mean(axis=0)
@@ -191,6 +190,15 @@ class LegCalibration:
         if np.linalg.norm(fwd) < 1e-6 * self.hip_height:
             fwd = np.array([0.0, 0.0, 1.0])
         return unit(fwd)
+
+    def hind(self, leg):
+        """Whether ``leg`` hangs from the hips (a quadruped's hind legs, a biped's two)."""
+        return self.skeleton.parents[leg.chain[0]] == self.hips
+
+    def leg_counts(self):
+        """(legs hanging from the hips, legs hanging from elsewhere)."""
+        hind = sum(self.hind(leg) for leg in self.legs)
+        return hind, len(self.legs) - hind
 
     def group(self, j):
         """The measure group of joint ``j``: ``legs``, ``spine`` (hips to chest), ``head``
@@ -208,11 +216,6 @@ class LegCalibration:
         if j in between:
             return "spine"
         return "head" if self.chest in up else "tail"
-
-
-def leg_counts(cal):
-    hind = sum(cal.skeleton.parents[leg.chain[0]] == cal.hips for leg in cal.legs)
-    return f"{hind} legs from the hips and {len(cal.legs) - hind} from elsewhere"
 
 
 def leg_contacts(src, tgt, inverse, contact):

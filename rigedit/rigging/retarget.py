@@ -37,7 +37,7 @@ from ..animation.clip import Clip
 from .bake import assemble, to_clip
 from .calibrate import calibrate, model_stack
 from .contacts import clean_feet as hold_feet, clean_legs, detect_contacts
-from .limbs import LegCalibration, ground, leg_contacts, leg_counts
+from .limbs import LegCalibration, ground, leg_contacts
 from .name_map import auto_map
 from .transfer import transfer_rotations
 from .tree_map import leg_map, legs_agree
@@ -171,7 +171,8 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
     s_points = src.contacts
     if not humanoid:
         contact, s_points, s_legs = leg_contacts(src, tgt, inverse, contact)
-    rot, pairs = transfer_rotations(src, tgt, inverse, smats, scal, rf, contact if humanoid else None)
+    rot, pairs = transfer_rotations(src, tgt, inverse, smats, scal, rf,
+                                    contact if humanoid else None)
     scale = tgt.hip_height / src.hip_height
     hips = tgt.hips
     hips_s = smats[:, inverse[hips], :3, 3]
@@ -227,7 +228,8 @@ def _inverse_map(mapping, src, tgt, source_what, target_what):
     if len(set(mapping.values())) != len(mapping):
         raise ValueError(f"{target_what}: the joint map names a target joint twice")
     legs = "" if tgt.kind == "humanoid" or legs_agree(src, tgt) else \
-        f"; their legs differ ({leg_counts(src)} against {leg_counts(tgt)})"
+        "; their legs differ ({} legs from the hips and {} from elsewhere against {} and {})" \
+        .format(*src.leg_counts(), *tgt.leg_counts())
     if not mapping:
         raise ValueError(f"{source_what}: none of its {len(ssk)} joints maps onto "
                          f"{target_what}: they are not two humanoids (matched by structure) "

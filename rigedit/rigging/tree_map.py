@@ -25,10 +25,7 @@ MAX_ANGLE = 60.0
 def legs_agree(src, tgt):
     """Whether two leg calibrations have as many legs hanging from the hips and as many
     hanging from elsewhere."""
-    def counts(cal):
-        hind = sum(cal.skeleton.parents[leg.chain[0]] == cal.hips for leg in cal.legs)
-        return hind, len(cal.legs) - hind
-    return counts(src) == counts(tgt)
+    return src.leg_counts() == tgt.leg_counts()
 
 
 def _runs(skeleton, j):
