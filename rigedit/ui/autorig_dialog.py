@@ -242,8 +242,7 @@ class AutorigAction:
         self.w.document.set_rig(rig, modified=True)
         self.w.set_mode("edit")
         about = describe_report(getattr(rig, "autorig_report", None))
-        self.w.status(f"Auto-rigged {mesh.name}: {len(rig.skeleton)} joints, "
-                      f"{len(rig.vertices):,} vertices, {len(rig.clips)} clips"
-                      + (f"; {about}" if about else "")
-                      + "; bind mode: drag joints to fix them")
+        # short enough for the status bar beside the mode label; counts are in Info
+        self.w.status(f"Auto-rigged {mesh.name}" + (f": {about}" if about else "")
+                      + "; drag joints to fix them")
         return rig
