@@ -245,3 +245,20 @@ def test_result_without_report_still_opens(window, qtbot, monkeypatch, small_hum
     assert w.document.rig.skeleton.names == template.skeleton.names, w.last_error
     assert w.document.rig.path is None    # never the mesh's folder: Save must ask
     assert w.document.modified and w.document.mode == "edit"
+
+
+def test_real_autorig_lets_the_cancel_through(small_humanoid_obj):
+    # the editor's Cancel is an exception raised from the progress callback: autorig must
+    # let it through (not turn it into a bad-input error), whatever stage it is in
+    from rigedit.ui.jobs import Cancelled
+
+    stages = []
+
+    def progress(fraction, stage):
+        stages.append(stage)
+        if len(set(stages)) > 2:
+            raise Cancelled()
+
+    with pytest.raises(Cancelled):
+        rigedit.autorig(str(small_humanoid_obj), template="humanoid", progress=progress)
+    assert len(set(stages)) == 3
