@@ -18,7 +18,7 @@ from .graph import medial_graph
 from .medial import medial_cells, pack_spheres
 from .place import place_carried, place_chains
 from .search import discrete_embedding
-from .template import reduce_template
+from .template import reduce_template, surface_area
 
 __all__ = ["Embedding", "EmbeddingError", "embed_skeleton"]
 
@@ -138,7 +138,10 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None)
     frame["cell"] = field_.h
     kept = reduced.rest[~reduced.carried]
     if np.isfinite(reduced.height):
-        scale = frame["height"] / max(reduced.height, 1e-12)
+        # Height says how big a standing character is but shrinks in a crouch; surface area
+        # does not change with the pose but grows with girth: take the geometric mean.
+        scale = np.sqrt(frame["height"] / max(reduced.height, 1e-12)
+                        * np.sqrt(surface_area(vertices, faces) / max(reduced.area, 1e-300)))
     else:
         scale = frame["height"] / max(np.max(kept[:, 1]) - reduced.floor, 1e-12) / 1.1
     if len(graph.points) < len(reduced.joints):

@@ -32,6 +32,12 @@ W_DATA = 2.0
 #: has halved: 2% is a wrist or an ankle on a human, 10% a trunk.
 THIN = 0.005
 ROUNDS = 6
+#: A bone follows the direction the mesh gives it by how slender its part is: fully when
+#: the part's radius is small against the bone's length (an arm, a leg: the mesh shows
+#: which way they point), hardly when it is not (the spine in a trunk, a clavicle in a
+#: chest: the mesh says nothing of their direction, the template does). Half-way when the
+#: radius is a third of the length.
+SLENDER = 3.0
 #: Feet on the ground: joints whose template height above the template's ground is under
 #: this fraction of the joints' height span (ankles, hooves) keep that height above the
 #: mesh's lowest point, times the scale. Limbs say where a joint is across them, not along
@@ -104,7 +110,8 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
         # follow the mesh, the trunk keeps the template's directions (frames are shared)
         cur = x[cb] - x[pb]
         mid_depth = np.maximum(field(0.5 * (x[cb] + x[pb])), 0.0)
-        follow = 1.0 / (1.0 + (mid_depth / thin) ** 2)
+        follow = 1.0 / (1.0 + (SLENDER * mid_depth / np.maximum(
+            np.linalg.norm(cur, axis=1), 1e-12)) ** 2)
         v = np.array([Rotation.from_rotvec(follow[i] * least_rotation(tb[i], cur[i]).as_rotvec())
                       .apply(tb[i]) for i in range(len(tb))])
         direction = np.full((k, 3), np.nan)

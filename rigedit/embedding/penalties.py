@@ -101,3 +101,4 @@ def mirror_cost(p, q, plane_x, unit):
     across x = ``plane_x``; ``unit`` is 5% of the template's size in mesh units."""
     m = np.array([2.0 * plane_x - q[0], q[1], q[2]])
     return W_MIRROR * np.sum((p - m) ** 2, axis=-1) / (unit * unit)
+

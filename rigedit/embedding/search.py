@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .penalties import (SEPARATE_RATIO, W_CARRY, bone_costs, joint_costs, mirror_cost)
+from .penalties import SEPARATE_RATIO, W_CARRY, bone_costs, joint_costs, mirror_cost
 
 __all__ = ["Search", "discrete_embedding"]
 
@@ -127,9 +127,6 @@ def discrete_embedding(graph, template, frame, scale, progress=None):
     partner = {}
     for a, b in sep:
         partner.setdefault(max(a, b), []).append(min(a, b))
-
-    def bound(k, v):
-        return sum(best[c][v] for c in children[k]) if v >= 0 else 0.0
 
     heap = []
     f0 = down[0]

@@ -46,8 +46,8 @@ class ReducedTemplate:
     floor : float
         Ground height of the template: its mesh's lowest point when given, else estimated
         (see ``ANKLE_HEIGHT``).
-    height : float
-        Height of the template's mesh (NaN without one).
+    height, area : float
+        Height and surface area of the template's mesh (NaN without one).
     joints : (R,) int
         Template indices of the reduced joints, parent before child.
     parent : (R,) int
@@ -70,6 +70,7 @@ class ReducedTemplate:
     size: float
     floor: float
     height: float
+    area: float
     joints: np.ndarray
     parent: np.ndarray
     chains: list
@@ -175,12 +176,20 @@ def reduce_template(skeleton, mesh=None):
     mirror = _mirror(rest[reduced], rest[reduced[0]], size)
     kept_y = rest[kept, 1]
     floor = float(kept_y.min() - ANKLE_HEIGHT * np.ptp(kept_y))
-    height = np.nan
+    height = area = np.nan
     if mesh is not None:
         verts = np.asarray(mesh[0], dtype=np.float64)
         floor, height = float(verts[:, 1].min()), float(np.ptp(verts[:, 1]))
-    return ReducedTemplate(rest, parents.copy(), size, floor, height, np.asarray(reduced),
+        area = surface_area(verts, mesh[1])
+    return ReducedTemplate(rest, parents.copy(), size, floor, height, area, np.asarray(reduced),
                            parent, chains, length, optional, mirror, carried)
+
+
+def surface_area(vertices, faces):
+    """Total area of a triangle mesh."""
+    tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces, dtype=np.int64)]
+    return float(0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
+                                      axis=1).sum())
 
 
 def _optional(parent, length):
