@@ -135,8 +135,10 @@ def layer_costs(app, w, rounds=5, n=15):
     medians is kept."""
     render = w.plotter.render_window.Render
     scene, giz, axes, overlay = w.scene, w.gizmos, w.axes, w.overlay
-    floor = [w.plotter.actors.get(n) for n in ("rig-floor", "rig-grid")]
-    grid = floor[1]
+    # the floor: a textured plane (issue 12), or before it a plane and a line actor
+    floor = [a for a in (w.plotter.actors.get(n) for n in ("rig-floor", "rig-grid")) if a]
+    grid = w.plotter.actors.get("rig-grid")
+    texture = floor[0].GetTexture()
     opac = [a.GetProperty().GetOpacity() for a in floor]
 
     def opaque_floor(on):
@@ -157,7 +159,9 @@ def layer_costs(app, w, rounds=5, n=15):
         ("overlay renderer not drawn (bones + spheres + arrows)",
          overlay.DrawOff, overlay.DrawOn),
         ("floor grid lines hidden", lambda: grid.SetVisibility(False),
-         lambda: grid.SetVisibility(True)),
+         lambda: grid.SetVisibility(True)) if grid is not None else
+        ("floor grid texture off", lambda: floor[0].SetTexture(None),
+         lambda: floor[0].SetTexture(texture)),
         ("floor hidden (plane + grid)", lambda: scene.set_floor_visible(False),
          lambda: scene.set_floor_visible(True)),
         ("floor shown but opaque (plane + grid opacity 1)",
@@ -187,7 +191,7 @@ def layer_triangles(w):
         sphere = pv.wrap(pd).triangulate()
     arrows = sum(pv.wrap(a.GetMapper().GetInput()).triangulate().n_cells for a in w.axes.actors)
     floor = w.plotter.actors["rig-floor"].GetMapper().GetInput()
-    grid = w.plotter.actors["rig-grid"].GetMapper().GetInput()
+    grid = w.plotter.actors.get("rig-grid")
     bones = w.scene.bones
     return {"mesh triangles": len(w.document.rig.faces),
             "joint spheres": f"{len(w.gizmos.positions)} x {sphere.n_cells} = "
@@ -195,7 +199,8 @@ def layer_triangles(w):
             "axis arrows": f"{arrows:,} triangles",
             "bones": f"{bones.n_lines} lines",
             "floor plane": f"{pv.wrap(floor).triangulate().n_cells:,} triangles",
-            "floor grid": f"{pv.wrap(grid).n_cells:,} lines"}
+            "floor grid": f"{pv.wrap(grid.GetMapper().GetInput()).n_cells:,} lines"
+            if grid is not None else "a texture on the plane"}
 
 
 def pipeline_costs(w):

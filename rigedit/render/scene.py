@@ -75,6 +75,9 @@ class RigScene:
         instead of recomputed by ``vtkPolyDataNormals`` each frame: exact in the rest pose,
         within shading noise when posed (README, Speed). Used while :attr:`skinning` is
         "lbs"; with "dqs" the filter runs (the DQS kernel blends no normals).
+    floor_style : {"plane", "lines"}
+        The floor as a textured plane (the editor) or its grid lines alone (the recorder;
+        see :func:`rigedit.render.floor.add_floor`).
 
     Attributes
     ----------
@@ -85,7 +88,7 @@ class RigScene:
     """
 
     def __init__(self, plotter, rig, show_skeleton=True, show_floor=True, skinning="lbs",
-                 skinned_normals=True):
+                 skinned_normals=True, floor_style="plane"):
         self.plotter = plotter
         self.rig = rig
         self._skinning = skinning
@@ -133,7 +136,7 @@ class RigScene:
         self.joint_actor = self.tails = None
         if not self.has_mesh:
             self._add_bare_skeleton(plotter)
-        self.floor_actor = self._add_floor() if show_floor else None
+        self.floor_actor = self._add_floor(floor_style) if show_floor else None
         self.display_mode = "solid"
         self.weights_shown = False
         self._weight_lut = None
@@ -263,10 +266,10 @@ class RigScene:
         return np.concatenate([joint_points(rig, rig.joint_matrices(clip.sample(t, out=pose)))
                                for t in np.linspace(0.0, clip.duration, samples)])
 
-    def _add_floor(self):
+    def _add_floor(self, style):
         points = self.rest_points()
         return add_floor(self.plotter, points.min(axis=0), points.max(axis=0),
-                         1 if self.rig.up == "y" else 2, self.up)
+                         1 if self.rig.up == "y" else 2, self.up, style=style)
 
     def set_skeleton_visible(self, visible):
         self.bone_actor.SetVisibility(bool(visible))
