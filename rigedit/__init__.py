@@ -17,8 +17,8 @@ from .errors import RigFileError
 from .model import Pose, Skeleton, SkinBinding
 from .rig import Rig
 
-__all__ = ["load_rig", "save_rig", "retarget", "autorig", "resolve_rig_path", "BUNDLED", "ASSETS_DIR", "Rig",
-           "Skeleton", "Pose", "Clip", "Track", "SkinBinding", "RigFileError"]
+__all__ = ["load_rig", "save_rig", "retarget", "autorig", "resolve_rig_path", "BUNDLED",
+           "ASSETS_DIR", "Rig", "Skeleton", "Pose", "Clip", "Track", "SkinBinding", "RigFileError"]
 __version__ = "0.1.0"
 
 

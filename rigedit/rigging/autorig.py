@@ -31,7 +31,7 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import RigFileError
 from .mesh_check import check_mesh, read_mesh
-from .orient import Orientation, axis_name, orient
+from .orient import Orientation, check_axes, orient
 
 __all__ = ["autorig", "AutorigReport", "load_template", "build_skeleton", "STAGES"]
 
@@ -275,6 +275,7 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
 
     t0 = time.perf_counter()
     band("load/check")(0.0)
+    check_axes(up, forward)          # a usage error before any file is read
     t_rig, t_sk, t_name = load_template(template)
     if isinstance(mesh, (str, Path)):
         source = str(mesh)
@@ -290,10 +291,7 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     t0 = time.perf_counter()
     band("orient")(0.0)
     body_v, body_f = checks.vertices, checks.faces[checks.body]
-    try:
-        orientation = orient(body_v, body_f, upright=_upright(t_sk), up=up, forward=forward)
-    except ValueError as exc:
-        raise RigFileError(source, str(exc)) from None
+    orientation = orient(body_v, body_f, upright=_upright(t_sk), up=up, forward=forward)
     place = _placement(vertices, orientation)
     seconds["orient"] = time.perf_counter() - t0
 

@@ -76,8 +76,9 @@ class MeshCheck:
 
     def lines(self):
         """Short human-readable lines for the CLI and the editor."""
-        holes = (f"{len(self.holes)} holes, the largest {100 * self.holes[0]:.1f}% of the "
-                 f"size across" if self.holes else "closed (no holes)")
+        holes = (f"{len(self.holes)} hole{'s' * (len(self.holes) > 1)}, the largest "
+                 f"{100 * self.holes[0]:.1f}% of the size across" if self.holes
+                 else "closed (no holes)")
         small = sum(s < SMALL_PART for s in self.part_shares)
         parts = ("one part" if len(self.part_shares) == 1 else
                  f"{len(self.part_shares)} parts, the largest {100 * self.part_shares[0]:.0f}% "

@@ -40,7 +40,7 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.spatial import ConvexHull, cKDTree
 
-__all__ = ["Orientation", "orient", "parse_axis", "axis_name", "SNAP_DEGREES"]
+__all__ = ["Orientation", "orient", "check_axes", "parse_axis", "axis_name", "SNAP_DEGREES"]
 
 SAMPLES = 4000
 SNAP_DEGREES = 15.0
@@ -51,6 +51,7 @@ END_SLICE = 0.03
 GROUND_DEGREES = 20.0
 SURE_GROUND_TURN = 10.0
 GROUND_TOUCH = 0.005
+GROUND_SPAN = 0.2
 SURE_FORWARD = 0.01
 SURE_SYMMETRY = 0.03   # mean mirror mismatch, as a fraction of the size, for "symmetric"
 
@@ -195,9 +196,10 @@ def _symmetry_plane(points, size, fixed=None):
         e1, e2 = _tangents(fixed)
         th = np.linspace(0, np.pi, 90, endpoint=False)
         cands = np.outer(np.cos(th), e1) + np.outer(np.sin(th), e2)
-    scores = [_mirror_cost(sub, tree, c, 0.0, centre) for c in cands]
+    coarse = points[:: max(1, len(points) // 300)]   # screening: 300 points tell planes apart
+    scores = [_mirror_cost(coarse, tree, c, 0.0, centre) for c in cands]
     best = None
-    for c in cands[np.argsort(scores)[:4]]:
+    for c in cands[np.argsort(scores)[:2]]:
         e1, e2 = _tangents(c) if fixed is None else (_unit(np.cross(fixed, c)), np.zeros(3))
 
         def f(x, c=c, e1=e1, e2=e2):
@@ -221,6 +223,26 @@ def _as_vector(v, what):
     if not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0:
         raise ValueError(f"expected a direction for {what}, got {v}")
     return _unit(v)
+
+
+def check_axes(up, forward):
+    """``up`` and ``forward`` as unit vectors (None where not given).
+
+    Raises
+    ------
+    ValueError
+        Not axes or vectors, or both given and not at right angles.
+    """
+    up, forward = _as_vector(up, "up"), _as_vector(forward, "forward")
+    if up is not None and forward is not None and abs(up @ forward) > 1e-6:
+        raise ValueError(f"expected --up and --forward at right angles, got up "
+                         f"{axis_name(up)} and forward {axis_name(forward)}")
+    return up, forward
+
+
+def _angle(a, b):
+    """Degrees between unit vectors."""
+    return float(np.degrees(np.arccos(np.clip(np.dot(a, b), -1.0, 1.0))))
 
 
 def _nearest_axis(v):
@@ -264,11 +286,19 @@ def _forward_cue(points, up, fwd, upright):
     return float((middle - legs.mean()) / max(np.ptp(along), 1e-12))
 
 
-def _support_up(points, normal, up, size):
+def _support_up(points, normal, up, size, level=None):
     """``up`` turned in the mirror plane so that the ground is level. The ground is the line
     of support (in the mirror plane, within :data:`GROUND_DEGREES` of below) that most of the
     surface touches, within :data:`GROUND_TOUCH` of the size: the soles, the hooves; a line
-    grazing a heel's curve or running from a hoof to the chin touches only points."""
+    grazing a heel's curve or running from a hoof to the chin touches only points.
+
+    With ``level`` (the centre of volume, (3,)), return instead whether ``up`` itself is
+    level ground: the most touched line lies within a degree of it, its contacts lie apart
+    (at least :data:`GROUND_SPAN` of the size: heel and toe, fore and hind hooves; not one
+    point contact among ties), hold the body up (the centre of volume lies between them,
+    seen from above), and are feet: each group of contacts (split where they lie more than
+    :data:`GROUND_SPAN` / 4 apart) touches on both sides of the mirror plane, as left and
+    right feet do, not at a chin or a tail on the middle."""
     e1, e2 = _tangents(normal)
     flat = np.c_[points @ e1, points @ e2]
     down = -np.array([up @ e1, up @ e2])
@@ -282,8 +312,26 @@ def _support_up(points, normal, up, size):
         proj = d @ flat.T                                   # (A, N)
         touch = (proj > proj.max(axis=1, keepdims=True) - GROUND_TOUCH * size).sum(axis=1)
         # ties go to the angle nearest the estimate
-        best = ang[np.lexsort((np.abs(ang - centre), -touch))[0]]
-    return _unit(-(np.cos(best) * e1 + np.sin(best) * e2))
+        pick = np.lexsort((np.abs(ang - centre), -touch))[0]
+        best = ang[pick]
+    found = _unit(-(np.cos(best) * e1 + np.sin(best) * e2))
+    if level is not None:
+        d = np.array([np.cos(best), np.sin(best)])
+        along = np.array([-d[1], d[0]])
+        proj = flat @ d
+        touching = proj > proj.max() - GROUND_TOUCH * size
+        contact = flat[touching] @ along
+        c = np.array([level @ e1, level @ e2]) @ along
+        if not (_angle(found, up) <= 1.0 and np.ptp(contact) >= GROUND_SPAN * size
+                and contact.min() < c < contact.max()):
+            return False
+        side = points[touching] @ normal - np.median(points @ normal)
+        order = np.argsort(contact)
+        groups = np.split(order, np.flatnonzero(np.diff(contact[order]) >
+                                                GROUND_SPAN / 4 * size) + 1)
+        return all((side[g] > GROUND_TOUCH * size).any() and (side[g] < -GROUND_TOUCH * size).any()
+                   for g in groups)
+    return found
 
 
 def _up_score(points, vertices, faces, up):
@@ -325,11 +373,8 @@ def orient(vertices, faces, upright=True, up=None, forward=None):
     """
     vertices = np.asarray(vertices, dtype=np.float64)
     faces = np.asarray(faces, dtype=np.int64)
-    up, forward = _as_vector(up, "up"), _as_vector(forward, "forward")
+    up, forward = check_axes(up, forward)
     if up is not None and forward is not None:
-        if abs(up @ forward) > 1e-6:
-            raise ValueError(f"expected --up and --forward at right angles, got up "
-                             f"{axis_name(up)} and forward {axis_name(forward)}")
         return Orientation(up, forward, guessed=False, sure=True)
     points = surface_samples(vertices, faces)
     size = float(np.ptp(points, axis=0).max())
@@ -351,12 +396,19 @@ def orient(vertices, faces, upright=True, up=None, forward=None):
             notes["elongation"] = float(ext[0] / max(ext[1], 1e-12))
             sure &= notes["elongation"] >= SURE_ELONGATION
             vertical = _unit(major if upright else minor)
-            if aligned is not None:
-                # a file saved along its axes: the vertical is the in-plane axis nearest the
-                # estimate (a long neck tilts the principal axes by tens of degrees)
-                k = int(np.argmax(np.abs(vertical) * (np.abs(normal) < 0.5)))
-                vertical = np.eye(3)[k] * np.sign(vertical[k])
-        ups = [s * vertical if aligned is not None else
+        snapped = False
+        if aligned is not None:
+            # a file saved along its axes: the vertical is an in-plane file axis when the
+            # estimate is near one (a tall body), or, for a long body (a long neck tilts its
+            # principal axes by tens of degrees), when the ground is level across that axis
+            k = int(np.argmax(np.abs(vertical) * (np.abs(normal) < 0.5)))
+            axis = np.eye(3)[k] * np.sign(vertical[k])
+            snapped = _angle(axis, vertical) <= SNAP_DEGREES if upright else any(
+                _support_up(points, normal, s * axis, size, level=volume_centroid(vertices, faces))
+                for s in (1.0, -1.0))
+            if snapped:
+                vertical = axis
+        ups = [s * vertical if snapped else
                _support_up(points, normal, s * vertical, size) for s in (1.0, -1.0)]
         scores = [_up_score(points, vertices, faces, u) for u in ups]
         k = int(scores[1][0] > scores[0][0])
@@ -367,7 +419,7 @@ def orient(vertices, faces, upright=True, up=None, forward=None):
         sure &= notes["up"] >= 1.0 and notes["ground_turn"] <= SURE_GROUND_TURN
         # a long body's principal axes tilt with its neck and head (36 degrees on the bundled
         # elk): off the file's axes, nothing pins its vertical down, so never claim it
-        sure &= upright or aligned is not None
+        sure &= upright or snapped
     if forward is None:
         fwd = _unit(np.cross(normal, up))
         cue = _forward_cue(points, up, fwd, upright)
