@@ -300,8 +300,12 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     remap = np.full(len(body_v), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
     emb_v = body_v[used] @ place[:3, :3].T + place[:3, 3]
+    t_mesh = None
+    if t_rig is not None and len(t_rig.vertices) and len(t_rig.faces):
+        t_mesh = (t_rig.skin(t_rig.rest_pose()), t_rig.faces)   # the rest pose's, as the joints
     try:
-        emb = embed_skeleton(emb_v, remap[body_f], t_sk, progress=band("embedding"))
+        emb = embed_skeleton(emb_v, remap[body_f], t_sk, progress=band("embedding"),
+                             template_mesh=t_mesh)
     except EmbeddingError as exc:
         raise RigFileError(source, f"{exc} (template {t_name}, orientation "
                                    f"{orientation.describe()})") from None
