@@ -37,6 +37,10 @@ def test_hover_highlights_the_sphere_a_press_would_grab(window):
     _event(window, "move", *_empty_pixel(window))
     assert g.hovered is None
     np.testing.assert_allclose(g.glyphs.color_of(j), plain)
+    _event(window, "move", *g.display_position(j))
+    assert g.hovered == j
+    window.plotter.iren.interactor.InvokeEvent("LeaveEvent")  # the mouse left the view
+    assert g.hovered is None
 
 
 def test_joints_one_behind_the_other_pick_the_nearer(window):

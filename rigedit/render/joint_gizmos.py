@@ -209,8 +209,8 @@ class JointGizmos(LeftButtonDrag):
             self.end_drag()
 
     def hover(self, iren, x, y):
-        """Highlight the sphere a press would grab."""
-        j = self.pick(x, y)
+        """Highlight the sphere a press would grab (none once the mouse left the view)."""
+        j = None if x is None else self.pick(x, y)
         if j != self.hovered:
             self.glyphs.set_state(hovered=j)
             iren.Render()

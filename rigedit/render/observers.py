@@ -84,10 +84,16 @@ class LeftButtonDrag:
         """Start listening to ``iren``; returns the observer tags."""
         return add_mouse_observers(
             iren, {"LeftButtonPressEvent": self._press, "MouseMoveEvent": self._mouse_move,
-                   "LeftButtonReleaseEvent": self._release}, priority, self, what)
+                   "LeftButtonReleaseEvent": self._release, "LeaveEvent": self._leave},
+            priority, self, what)
 
     def hover(self, iren, x, y):
-        """A mouse move with no drag (nothing by default)."""
+        """A mouse move with no drag, or the mouse leaving the view (``x``, ``y`` None);
+        nothing by default."""
+
+    def _leave(self, iren):
+        self.hover(iren, None, None)
+        return False
 
     def _press(self, iren):
         if self._grab is not None:
