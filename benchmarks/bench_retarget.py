@@ -85,7 +85,7 @@ def humanoids(markdown):
 
 def quadrupeds(markdown):
     sys.path.insert(0, str(REPO / "tests"))
-    from quadruped_variants import VARIANTS, renamed, variant
+    from quadruped_variants import FORE, VARIANTS, fore_variant, renamed, variant
 
     quad = rigedit.load_rig("quadruped")
     head = ["clip", "target", "legs°", "spine°", "neck/head°", "tail°", "slip src mm",
@@ -93,6 +93,7 @@ def quadrupeds(markdown):
             "time s"]
     targets = {"itself": (quad, None)}
     targets.update({v: (variant(quad.skeleton, **kw), None) for v, kw in VARIANTS.items()})
+    targets.update({v: (fore_variant(quad.skeleton, f), None) for v, f in FORE.items()})
     first = next(iter(VARIANTS))
     other = variant(quad.skeleton, **VARIANTS[first], rename=renamed)
     targets[f"{first}, other names (map)"] = (other,

@@ -13,7 +13,8 @@ LEG_PARTS = ("fore_lower", "fore_cannon", "fore_hoof", "hind_shin", "hind_cannon
 NECK = ("neck_2", "neck_3", "head")
 
 
-def variant(skeleton, scale=1.0, legs=1.0, neck=1.0, bend=0.0, rename=None):
+def variant(skeleton, scale=1.0, legs=1.0, neck=1.0, bend=0.0, fore=1.0, pitch=0.0,
+            rename=None):
     """A changed copy of the bundled quadruped's skeleton, standing on y = 0 again.
 
     Parameters
@@ -25,6 +26,11 @@ def variant(skeleton, scale=1.0, legs=1.0, neck=1.0, bend=0.0, rename=None):
     legs, neck : float
         The leg bones below the shoulder and hip joints, and the neck and head offsets,
         times these (before ``scale``).
+    fore : float
+        The fore legs' bones below the shoulder joints times this too.
+    pitch : float
+        Degrees the rest pose turns the spine at ``spine_1`` about +X (positive lowers the
+        front), so that fore legs of another length can stand on the floor too.
     bend : float
         Degrees the rest pose turns the fore legs forward at the shoulder and the hind legs
         back at the hip (about +X), and the cannons half as much the other way.
@@ -41,7 +47,7 @@ def variant(skeleton, scale=1.0, legs=1.0, neck=1.0, bend=0.0, rename=None):
     for name in sk.names:
         base = name.rsplit("_", 1)[0] if name.endswith(("_L", "_R")) else name
         if base in LEG_PARTS:
-            factor[sk.index[name]] *= legs
+            factor[sk.index[name]] *= legs * (fore if base.startswith("fore") else 1.0)
         if base in NECK:
             factor[sk.index[name]] *= neck
     trans = sk.rest_translation * factor[:, None]
@@ -52,6 +58,8 @@ def variant(skeleton, scale=1.0, legs=1.0, neck=1.0, bend=0.0, rename=None):
             j = sk.index[name]
             rot[j] = (Rotation.from_euler("x", deg, degrees=True)
                       * Rotation.from_quat(rot[j])).as_quat()
+    j = sk.index["spine_1"]
+    rot[j] = (Rotation.from_euler("x", pitch, degrees=True) * Rotation.from_quat(rot[j])).as_quat()
     names = [rename(n) for n in sk.names] if rename else list(sk.names)
     new = Skeleton(names, sk.parents, trans, rot, sk.rest_scale, deform=sk.deform)
     old_m, new_m = sk.bind_matrices, new.bind_matrices
@@ -75,6 +83,16 @@ VARIANTS = {
 }
 
 
+#: Fore legs of another length than the hind ones (a hyena, a giraffe): fore factor, the
+#: rest's spine turned (:func:`level_pitch`) so all four hooves stand on the floor.
+FORE = {"fore legs x0.8, rest sloping down": 0.8, "fore legs x1.25, rest sloping up": 1.25}
+
+
+def fore_variant(skeleton, fore):
+    """:func:`variant` with fore legs ``fore`` times as long, standing on all four."""
+    return variant(skeleton, fore=fore, pitch=level_pitch(skeleton, fore=fore))
+
+
 def renamed(name):
     """Other joint names: ``pelvis`` -> ``Q_Pelvis``, ``fore_upper_L`` -> ``Q_ForeUpper.l``."""
     side = ""
@@ -85,3 +103,15 @@ def renamed(name):
 
 def quadruped():
     return rigedit.load_rig("quadruped")
+
+
+def level_pitch(skeleton, **kw):
+    """The ``pitch`` (degrees) at which a variant's fore and hind hooves stand on one level."""
+    from scipy.optimize import brentq
+
+    def gap(deg):
+        sk = variant(skeleton, pitch=deg, **kw).skeleton
+        y = sk.bind_matrices[:, 1, 3]
+        return min(y[sk.index["fore_hoof_L"]], y[sk.index["fore_hoof_R"]]) - \
+            min(y[sk.index["hind_hoof_L"]], y[sk.index["hind_hoof_R"]])
+    return brentq(gap, -40.0, 40.0, xtol=1e-6)

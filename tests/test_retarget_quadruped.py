@@ -20,7 +20,7 @@ from rigedit.rigging.limbs import LegCalibration
 from rigedit.rigging.measure import (direction_errors, foot_slip, lowest_foot,
                                      source_foot_points, target_foot_points)
 
-from quadruped_variants import VARIANTS, renamed, variant
+from quadruped_variants import VARIANTS, fore_variant, renamed, variant
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -59,8 +59,8 @@ def test_legs_found_by_structure(quad):
 @pytest.mark.parametrize("clip", ["walk", "run", "idle", "head_nod"])
 def test_identity_reproduces_the_clip(quad, clip):
     """Onto itself (the identity map is found from the names) every joint comes back: exactly
-    without the foot clean-up, within 2 mm with it (it only holds the source's own 0-4 mm
-    of slip)."""
+    without the foot clean-up, within 1 cm with it (it holds the source's own slip, 0-4 mm
+    per contact on average; measured 6.1 mm at most, at a fore cannon)."""
     raw = retarget_result(quad, clip, quad, clean_feet=False)
     res = retarget_result(quad, clip, quad)
     assert raw.mapping == {n: n for n in quad.skeleton.names}
@@ -69,7 +69,7 @@ def test_identity_reproduces_the_clip(quad, clip):
     for t in np.linspace(0, src.duration, 7):
         want = _positions(quad.skeleton, src, t)
         assert np.abs(_positions(quad.skeleton, raw.clip, t) - want).max() < 1e-6
-        assert np.abs(_positions(quad.skeleton, res.clip, t) - want).max() < 2e-3  # 1.8 mm
+        assert np.abs(_positions(quad.skeleton, res.clip, t) - want).max() < 1e-2
 
 
 @pytest.fixture(scope="module")
@@ -90,14 +90,40 @@ CASES = [(v, c) for v in VARIANTS for c in ("walk", "run")]
 @pytest.mark.parametrize("vname,clip", CASES)
 def test_bones_point_like_the_source(results, vname, clip):
     """Before the clean-up every mapped bone points exactly as its source bone (whatever the
-    target's proportions and rest pose); after it the spine, neck, head and tail still do,
-    and the legs within a degree on average (measured 0.01-0.8)."""
+    target's proportions and rest pose); after it the tail still does, the legs within a
+    degree on average (measured 0.01-0.5), and the spine, neck and head within the body's
+    pitch: none where the fore and hind legs keep the source's ratio (a uniform scale),
+    1.4 degrees at most measured on the others."""
     res = results(vname, clip)
     raw = direction_errors(res, res.raw_mats)
     assert max(raw[g] for g in ("legs", "spine", "head", "tail")) < 1e-6, raw
     err = direction_errors(res)
-    assert max(err[g] for g in ("spine", "head", "tail")) < 1e-6, err
-    assert err["legs"] < 1.0, err
+    assert err["tail"] < 1e-6 and err["legs"] < 1.0, err
+    uniform = "scale" in VARIANTS[vname] and "legs" not in VARIANTS[vname]
+    assert max(err["spine"], err["head"]) < (1e-6 if uniform else 2.0), err
+
+
+@pytest.mark.parametrize("fore,sign", [(0.8, -1), (1.25, 1)])
+def test_body_pitches_for_shorter_or_longer_fore_legs(quad, fore, sign):
+    """Fore legs 20% shorter (25% longer) than the bundled ones, hind legs as they are, the
+    rest's spine turned so all four hooves stand on the floor (a hyena, a giraffe): the body
+    turns about the hips, front down (up), instead of dropping and bending the legs; the
+    hooves still hold and stay on the floor."""
+    target = fore_variant(quad.skeleton, fore)
+    assert len(calibrate(target.skeleton, [], "variant", LegCalibration).legs) == 4
+    res = retarget_result(quad, "walk", target)
+    hips = res.target_calibration.hips
+    # the hips do not drop (measured 0.0 mm for both)
+    assert np.abs(res.mats[:, hips, 1, 3] - res.raw_mats[:, hips, 1, 3]).max() < 0.005
+    err = direction_errors(res)
+    assert err["legs"] < 1.0 and err["tail"] < 1e-6, err
+    assert 8.0 < err["spine"] < 25.0, err  # measured 13.3 and 17.5 degrees
+    sk = target.skeleton
+    spine = res.mats[:, sk.index["spine_3"], :3, 3] - res.mats[:, hips, :3, 3]
+    raw_spine = res.raw_mats[:, sk.index["spine_3"], :3, 3] - res.raw_mats[:, hips, :3, 3]
+    assert np.all(sign * (spine[:, 1] - raw_spine[:, 1]) > 0.05)
+    assert foot_slip(target_foot_points(res), res.contact).max() < 1e-6
+    assert lowest_foot(res) > -1e-6
 
 
 @pytest.mark.parametrize("vname,clip", CASES)
@@ -108,8 +134,8 @@ def test_feet_hold_and_stay_above_the_floor(results, vname, clip):
     after = foot_slip(target_foot_points(res), res.contact)
     assert after.max() < 1e-6, after  # each contact held still (measured 1e-12)
     src = foot_slip(source_foot_points(res), res.contact) * res.scale
-    if abs(res.scale - 1.3) < 1e-9:  # longer legs: the raw feet slide (about 3x the source)
-        assert before.mean() > 2 * src.mean()
+    if abs(res.scale - 1.3) < 1e-9:  # longer legs: the raw feet slide (1.9x the source)
+        assert before.mean() > 1.5 * src.mean()
     assert lowest_foot(res) > -1e-6
     hoof_tips = res.target_calibration.foot_points(res.mats)[..., 1].min(axis=1)
     # on the floor while a hoof stands: the lowest point is the floor in most frames
@@ -293,7 +319,10 @@ def test_template_clips_onto_a_character_of_its_names(template):
         assert set(res.mapping.items()) >= {(n, n) for n in sk.names if n != "root"}
         err = direction_errors(res)
         groups = [g for g in res.target_calibration.groups if g not in ("legs", "feet")]
-        assert max(err[g] for g in groups) < 1e-3, (name, err)
+        # the quadruped's body pitches where its fore legs grew less than its hind legs
+        # (measured up to 3.4 degrees); a humanoid's body does not
+        assert max(err[g] for g in groups) < (5.0 if template == "quadruped" else 1e-3), \
+            (name, err)
         assert err["legs"] < 3.0, (name, err)
         assert lowest_foot(res) > -1e-6
         assert res.clip.duration == clip.duration and res.clip.skeleton is new_sk
@@ -316,7 +345,8 @@ def test_blender_style_names_map_by_normalised_names(quad, results):
 def test_jittered_joints_as_an_embedding_places_them(quad):
     """An auto-rigged character's joints are where the embedding put them, not on a clean
     grid: every joint moved by up to a few centimetres, no tails. The legs are still found,
-    the hooves held and kept above the floor, the body's bones still point as the source's."""
+    the hooves held and kept above the floor, the tail points as the source's and the body
+    within its pitch."""
     sk = quad.skeleton
     rng = np.random.default_rng(7)
     trans = sk.rest_translation + np.clip(rng.normal(0, 0.015, sk.rest_translation.shape),
@@ -333,7 +363,8 @@ def test_jittered_joints_as_an_embedding_places_them(quad):
         assert foot_slip(target_foot_points(res), res.contact).max() < 1e-6
         assert lowest_foot(res) > -1e-6
         err = direction_errors(res)
-        assert max(err[g] for g in ("spine", "head", "tail")) < 1e-6, err
+        assert err["tail"] < 1e-6, err
+        assert max(err["spine"], err["head"]) < 3.0, err  # the pitch: measured 2.0 degrees
         assert err["legs"] < 3.0, err
 
 

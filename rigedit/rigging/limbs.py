@@ -22,7 +22,7 @@ import numpy as np
 from .calibrate import foot_points, unit
 from .name_map import _KNEE, bend_index
 
-__all__ = ["Leg", "find_legs", "LegCalibration", "leg_contacts", "ground",
+__all__ = ["Leg", "find_legs", "LegCalibration", "leg_contacts", "ground", "motion_ground",
            "LEG_GROUPS", "FOOT_TOL", "BRANCH_HEIGHT"]
 
 FOOT_TOL = 0.1
@@ -161,9 +161,7 @@ class LegCalibration:
         # rest with bent legs does not shrink it; the hips joint sits hip_offset above the
         # legs' top joints.
         hind = [leg for leg in self.legs if self.hind(leg)] or self.legs
-        self.hip_height = float(np.mean(
-            [np.linalg.norm(np.diff(p[leg.chain], axis=0), axis=1).sum() for leg in hind])
-            + np.mean([p[leg.contact, 1] for leg in hind]) - self.joint_floor)
+        self.hip_height = float(np.mean([self.straight(leg) for leg in hind]))
         self.hip_offset = float(p[self.hips, 1] - np.mean([p[leg.chain[0], 1] for leg in hind]))
         self.up = np.array([0.0, 1.0, 0.0])
         self.forward = self._forward()
@@ -194,6 +192,15 @@ class LegCalibration:
     def hind(self, leg):
         """Whether ``leg`` hangs from the hips (a quadruped's hind legs, a biped's two)."""
         return self.skeleton.parents[leg.chain[0]] == self.hips
+
+    def straight(self, leg):
+        """The leg's length standing straight, whatever the pose: its bones' lengths from the
+        top joint down to the foot leaf, and the leaf's tail (a hoof) where it has one."""
+        p = self.points
+        tail = tail_points(self.skeleton, self.mats)[leg.contact]
+        end = float(np.linalg.norm(tail - p[leg.contact])) if np.all(np.isfinite(tail)) \
+            else 0.0
+        return float(np.linalg.norm(np.diff(p[leg.chain], axis=0), axis=1).sum() + end)
 
     def leg_counts(self):
         """(legs hanging from the hips, legs hanging from elsewhere)."""
@@ -256,8 +263,8 @@ def ground(src, tgt, smats, raw, s_legs, scale):
     shift : float
     heights : (F, len(tgt.legs)) float64
     """
-    s_ground = np.percentile(src.foot_points(smats)[..., 1].min(axis=1), 5)
-    shift = tgt.floor - np.percentile(tgt.foot_points(raw)[..., 1].min(axis=1), 5)
+    s_ground = motion_ground(src, smats)
+    shift = tgt.floor - motion_ground(tgt, raw)
     heights = raw[:, tgt.contacts, 1, 3].copy()
     for i, (leg, k) in enumerate(zip(tgt.legs, s_legs)):
         if k is None:
@@ -266,3 +273,12 @@ def ground(src, tgt, smats, raw, s_legs, scale):
         s_low = foot_points(src.skeleton, src.legs[k].foot, smats)[..., 1].min(axis=1)
         heights[:, i] += tgt.floor - shift + scale * (s_low - s_ground) - t_low
     return shift, heights
+
+
+def motion_ground(cal, mats):
+    """The ground a motion stands on: the 5th percentile over the frames of the lowest foot
+    point of the legs hanging from the hips (which place the hips; a quadruped's fore legs
+    are fitted by :func:`rigedit.rigging.pitch.pitch_body`), in the poses ``mats``
+    (F, J, 4, 4)."""
+    feet = [j for leg in cal.legs if cal.hind(leg) for j in leg.foot] or cal.feet
+    return float(np.percentile(foot_points(cal.skeleton, feet, mats)[..., 1].min(axis=1), 5))

@@ -39,6 +39,7 @@ from .calibrate import calibrate, model_stack
 from .contacts import clean_feet as hold_feet, clean_legs, detect_contacts
 from .limbs import LegCalibration, ground, leg_contacts
 from .name_map import auto_map
+from .pitch import pitch_body
 from .transfer import transfer_rotations
 from .tree_map import leg_map, legs_agree
 
@@ -194,8 +195,12 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
         if humanoid:
             rot, drop = hold_feet(tsk, tgt, rot, raw, contact, tgt.contacts, times, inverse)
         else:
-            rot, drop = clean_legs(tsk, tgt, rot, raw, contact, tgt.legs, times, inverse,
-                                   heights)
+            # fore and hind legs of other proportions than the source's: pitch the body
+            rot = rot.copy()
+            pitched = raw if pitch_body(src, tgt, rot, raw, smats, s_legs) is None else \
+                assemble(tsk, rot, hips, hips_t)
+            rot, drop = clean_legs(tsk, tgt, rot, pitched, contact, tgt.legs, times,
+                                   inverse, heights)
         hips_t = hips_t - np.c_[np.zeros_like(drop), drop, np.zeros_like(drop)]
         mats = assemble(tsk, rot, hips, hips_t)
     clip = to_clip(tsk, mats, rot, times, name or source_clip.name, source_clip, hips,
