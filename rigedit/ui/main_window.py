@@ -93,6 +93,27 @@ class MainWindow(MenusMixin, JobsMixin, QtWidgets.QMainWindow):
         Whether a gizmo drag is held.
     proxy_view : ProxyView
         Draws a big mesh's decimated proxy while it moves, and says so in the status bar.
+    radius : float
+        The joint spheres' radius (model units), from the rig; set with the scene.
+    files : FileActions
+        The File menu's work (open, save, export, weights).
+    joint_panel, info_panel : JointPanel, InfoPanel
+        In the docks ``joint_dock`` and ``info_dock``.
+    timeline : TimelineDock
+    progress, cancel_button, mode_label : QWidget
+        The status bar's job progress, its Cancel and the POSE / EDIT label.
+    weight_brush : WeightBrush
+    autosave : Autosave
+    error_display : ErrorDisplay
+        Shows unexpected errors (see :mod:`.errors_hook`).
+    last_error : str or None
+        The last error message shown.
+    keep_recovery, confirm_close : bool
+        Keep the recovery entry on close (quitting on a signal); ask about unsaved changes.
+    undo_action, redo_action, ... : QAction
+        The menus' and tool bar's actions, made by :class:`MenusMixin` (``gizmos_action``,
+        ``skeleton_action``, ``floor_action``, ``weights_action``, ``pose_mode_action``,
+        ``edit_mode_action``, ``display_actions``, ``axis_actions``, ``chain_spin`` ...).
     """
 
     def __init__(self, rig=None, parent=None):
@@ -109,6 +130,7 @@ class MainWindow(MenusMixin, JobsMixin, QtWidgets.QMainWindow):
         self.confirm_close = False   # ask about unsaved changes on close (app.py sets it)
         self._closed = False
         self.scene = self.overlay = self.gizmos = self.axes = self.drag = None  # _load_scene
+        self.radius = None
         self.rebind = RestRebind(self.document, self.run_job, lambda: self.job,
                                  self._refresh_view, self.status, lambda: self.interacting,
                                  self._update_undo_actions)
