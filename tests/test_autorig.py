@@ -238,3 +238,46 @@ def test_cli_homer_prints_orientation_checks_and_times(tmp_path, capsys):
     head = rig.skeleton.bind_matrices[rig.skeleton.index["Head"], 1, 3]
     foot = rig.skeleton.bind_matrices[rig.skeleton.index["LeftFoot"], 1, 3]
     assert head > 0.7 * np.ptp(rig.vertices[:, 1]) > foot
+
+
+def test_progress_reports_stages_in_order_and_a_raise_cancels():
+    ref = rigedit.load_rig("humanoid")
+    seen = []
+
+    class Cancelled(Exception):
+        pass
+
+    def progress(fraction, stage):
+        seen.append((fraction, stage))
+        if stage == "embedding" and fraction > 0.2:
+            raise Cancelled
+
+    with pytest.raises(Cancelled):
+        rigedit.autorig((ref.vertices, ref.faces), up="y", forward="z", progress=progress)
+    stages = [s for _, s in seen]
+    assert stages[0] == "load/check" and "orient" in stages and stages[-1] == "embedding"
+    fractions = [f for f, _ in seen]
+    assert fractions == sorted(fractions) and 0.0 <= fractions[0] and fractions[-1] < 0.6
+
+
+def test_skeleton_file_template_without_clips(tmp_path):
+    """A bare skeleton file: names and hierarchy come along, no clips (it has none)."""
+    if not HOMER.is_file():
+        pytest.skip(f"{HOMER} is absent (shared test data)")
+    from rigedit.io.skeleton_json import save_skeleton
+
+    ref = rigedit.load_rig("humanoid")
+    path = tmp_path / "skeleton.json"
+    save_skeleton(path, ref.skeleton)
+    rig = rigedit.autorig(HOMER, template=path, weights="idw")
+    assert rig.skeleton.names == ref.skeleton.names and rig.clips == {}
+    assert rig.autorig_report.template == str(path)
+    # homer stands the right way up in the skeleton (his head starts at about two thirds
+    # of his height), feet at the bottom, his left hand on +X
+    pos = rig.skeleton.bind_matrices[:, :3, 3]
+    sk = rig.skeleton
+    height = np.ptp(rig.vertices[:, 1])
+    y = {n: pos[sk.index[n], 1] for n in ("Head", "LeftArm", "Hips", "LeftLeg", "LeftFoot")}
+    assert y["Head"] > y["LeftArm"] > y["Hips"] > y["LeftLeg"] > y["LeftFoot"]
+    assert y["Head"] > 0.55 * height and y["LeftFoot"] < 0.15 * height
+    assert pos[sk.index["LeftHand"], 0] > 0 > pos[sk.index["RightHand"], 0]

@@ -1,0 +1,168 @@
+"""Auto-rigging: time of each stage, and joint placement (CD-J2J) through the whole pipeline.
+
+Run: ``.venv/bin/python benchmarks/bench_autorig.py [--speed] [--accuracy]`` (both by default).
+
+**Speed**: ``rigedit.autorig`` with heat weights and the template's clips on
+- a 50k-vertex mesh: the bundled humanoid's mesh (24,999 vertices) split once at edge
+  midpoints (VTK's linear subdivision, 99,982 vertices) and quadric-decimated back to about
+  50,000 vertices (pyvista ``decimate``), given in its own frame, orientation guessed;
+- ``cow.obj`` (quadruped template) and ``homer.obj`` (humanoid template) from
+  ``../shared/data/common-3d-test-models``, orientation guessed.
+Each stage's wall seconds are printed (load/check, orient, the embedding's own stages,
+weights, clips, total).
+
+**Accuracy**: CD-J2J (RigNet's symmetric chamfer distance between predicted and true joint
+positions, as a percentage of the bounding-box diagonal, ``rigedit.embedding.cd_j2j``) for
+the bundled characters' own meshes (truth: their shipped skeleton, every joint) and the
+Khronos CesiumMan and RiggedFigure (skinned at their rest pose; truth: the artist's joints
+that the name table below maps onto the humanoid template, only those counted). Each mesh is
+run twice: in its own frame with the orientation guessed, and turned (Z up, facing -X, times
+100, moved) with the orientation guessed again, so the guess is part of what is measured.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+import warnings
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import rigedit  # noqa: E402
+from rigedit.embedding import cd_j2j  # noqa: E402
+from rigedit.rigging.mesh_check import read_mesh  # noqa: E402
+
+DATA = ROOT.parent / "shared" / "data"
+
+#: Humanoid template joint -> the artist's joint (CesiumMan; RiggedFigure has the same names
+#: without the "Skeleton_" prefixes and with arm joints numbered from the shoulder).
+CESIUM = {"Hips": "Skeleton_torso_joint_1", "Spine": "Skeleton_torso_joint_2",
+          "Spine2": "torso_joint_3", "Neck": "Skeleton_neck_joint_1",
+          "Head": "Skeleton_neck_joint_2",
+          "LeftArm": "Skeleton_arm_joint_L__4_", "LeftForeArm": "Skeleton_arm_joint_L__3_",
+          "LeftHand": "Skeleton_arm_joint_L__2_", "RightArm": "Skeleton_arm_joint_R",
+          "RightForeArm": "Skeleton_arm_joint_R__2_", "RightHand": "Skeleton_arm_joint_R__3_",
+          "LeftUpLeg": "leg_joint_L_1", "LeftLeg": "leg_joint_L_2", "LeftFoot": "leg_joint_L_3",
+          "LeftToeBase": "leg_joint_L_5", "RightUpLeg": "leg_joint_R_1",
+          "RightLeg": "leg_joint_R_2", "RightFoot": "leg_joint_R_3",
+          "RightToeBase": "leg_joint_R_5"}
+RIGGED_FIGURE = {**{k: v.replace("Skeleton_", "") for k, v in CESIUM.items()},
+                 "LeftArm": "arm_joint_L_1", "LeftForeArm": "arm_joint_L_2",
+                 "LeftHand": "arm_joint_L_3", "RightArm": "arm_joint_R_1",
+                 "RightForeArm": "arm_joint_R_2", "RightHand": "arm_joint_R_3"}
+
+# rigedit axis -> the turned input's: up is the input's +Z, forward its -X (left: -Y)
+TURN = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+TURN_SCALE, TURN_SHIFT = 100.0, np.array([250.0, -40.0, 13.0])
+
+
+def _stage_line(seconds):
+    return ", ".join(f"{k} {v:.2f}" for k, v in seconds.items())
+
+
+def _fifty_k():
+    import pyvista as pv
+
+    rig = rigedit.load_rig("humanoid")
+    mesh = pv.PolyData(rig.vertices, np.c_[np.full(len(rig.faces), 3), rig.faces])
+    fine = mesh.subdivide(1, "linear")
+    target = 50_000
+    coarse = fine.decimate(1.0 - target / fine.n_points * 0.98)   # faces ~ 2 x points
+    faces = coarse.faces.reshape(-1, 4)[:, 1:]
+    return np.asarray(coarse.points, dtype=np.float64), faces, fine.n_points
+
+
+def speed():
+    v, f, fine = _fifty_k()
+    cases = [(f"humanoid mesh, subdivided ({fine} v) and decimated to {len(v)} vertices",
+              (v, f), "humanoid")]
+    for name, template in (("cow.obj", "quadruped"), ("homer.obj", "humanoid")):
+        path = DATA / "common-3d-test-models" / name
+        if path.is_file():
+            cases.append((f"{name} ({len(read_mesh(path)[0])} vertices)", str(path), template))
+    print("## Speed (seconds per stage, heat weights, template clips retargeted)")
+    for what, mesh, template in cases:
+        t0 = time.perf_counter()
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                rig = rigedit.autorig(mesh, template=template)
+        except ValueError as exc:
+            print(f"- {what}, template {template}: FAILED after {time.perf_counter() - t0:.1f} "
+                  f"s: {exc}")
+            continue
+        rep = rig.autorig_report
+        print(f"- {what}, template {template}: total {rep.seconds['total']:.1f} s; "
+              f"{rep.orientation.describe()}")
+        print(f"  {_stage_line(rep.seconds)}")
+
+
+def _truth_cases():
+    """(label, vertices, faces, template, predicted joint names, truth positions)."""
+    out = []
+    for name in ("humanoid", "quadruped"):
+        rig = rigedit.load_rig(name)
+        sk = rig.skeleton
+        out.append((f"bundled {name}", rig.vertices, rig.faces, name, list(sk.names),
+                    sk.bind_matrices[:, :3, 3]))
+    for file, table in (("CesiumMan.glb", CESIUM), ("RiggedFigure.glb", RIGGED_FIGURE)):
+        path = DATA / "khronos-gltf" / file
+        if not path.is_file():
+            continue
+        rig = rigedit.load_rig(path)
+        v = rig.skin(rig.rest_pose())
+        rest = rig.skeleton.forward(rig.skeleton.rest_local_matrices())
+        truth = np.array([rest[rig.skeleton.index[a], :3, 3] for a in table.values()])
+        out.append((file, v, rig.faces, "humanoid", list(table), truth))
+    return out
+
+
+def accuracy():
+    print("## CD-J2J (% of the bounding-box diagonal), whole pipeline, orientation guessed")
+    print("| mesh | frame | orientation | joints counted | CD-J2J |")
+    print("|---|---|---|---|---|")
+    for label, v, f, template, names, truth in _truth_cases():
+        for frame in ("own", "turned"):
+            if frame == "own":
+                verts, tv = v, truth
+            else:
+                verts = v @ TURN.T * TURN_SCALE + TURN_SHIFT
+                tv = truth @ TURN.T * TURN_SCALE + TURN_SHIFT
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    rig = rigedit.autorig((verts, f), template=template, clips=False)
+            except ValueError as exc:
+                print(f"| {label} | {frame} | - | - | FAILED: {exc} |")
+                continue
+            rep = rig.autorig_report
+            m = rep.transform
+            truth_rig = tv @ m[:3, :3].T + m[:3, 3]
+            pred = np.array([rig.skeleton.bind_matrices[rig.skeleton.index[n], :3, 3]
+                             for n in names])
+            diag = float(np.linalg.norm(np.ptp(rig.vertices, axis=0)))
+            print(f"| {label} | {frame} | {rep.orientation.describe()} | {len(names)} | "
+                  f"{cd_j2j(pred, truth_rig, diag):.2f}% |")
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--speed", action="store_true")
+    p.add_argument("--accuracy", action="store_true")
+    args = p.parse_args()
+    both = not (args.speed or args.accuracy)
+    if args.speed or both:
+        speed()
+    if args.accuracy or both:
+        accuracy()
+
+
+if __name__ == "__main__":
+    main()
