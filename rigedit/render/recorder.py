@@ -409,7 +409,6 @@ def _grid_floor(plotter, behind="#c3c9d0"):
         return
     bg = np.array(pv.Color(behind).float_rgb)
     alpha = 0.7  # a little stronger than in the editor: the recorder has no floor plane
-    actor.GetMapper().ScalarVisibilityOff()  # not the editor's per-point floor colours
     prop = actor.GetProperty()
     prop.SetColor(*(alpha * np.array(pv.Color(GRID_COLOR).float_rgb) + (1 - alpha) * bg))
     prop.LightingOff()
