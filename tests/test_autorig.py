@@ -281,3 +281,28 @@ def test_skeleton_file_template_without_clips(tmp_path):
     assert y["Head"] > y["LeftArm"] > y["Hips"] > y["LeftLeg"] > y["LeftFoot"]
     assert y["Head"] > 0.55 * height and y["LeftFoot"] < 0.15 * height
     assert pos[sk.index["LeftHand"], 0] > 0 > pos[sk.index["RightHand"], 0]
+
+
+def test_cow_as_a_quadruped_walks():
+    """cow.obj faces +X with +Y up: guessed, embedded with the quadruped template, and the
+    template's walk retargeted: hooves low, head forward, feet on the floor while it walks."""
+    cow = DATA / "common-3d-test-models" / "cow.obj"
+    if not cow.is_file():
+        pytest.skip(f"{cow} is absent (shared test data)")
+    rig = rigedit.autorig(cow, template="quadruped")
+    o = rig.autorig_report.orientation
+    assert o.sure and o.describe() == "up +y, forward +x (guessed)"
+    assert set(rig.autorig_report.clips.values()) == {"retargeted"}
+    sk = rig.skeleton
+    pos = sk.bind_matrices[:, :3, 3]
+    height = np.ptp(rig.vertices[:, 1])
+    hooves = [sk.index[f"{leg}_hoof_{s}"] for leg in ("fore", "hind") for s in "LR"]
+    assert pos[hooves, 1].max() < 0.15 * height
+    assert pos[sk.index["head"], 2] > pos[sk.index["pelvis"], 2] + 0.3 * height
+    assert pos[sk.index["fore_hoof_L"], 0] > 0 > pos[sk.index["fore_hoof_R"], 0]
+    walk = rig.clips["walk"]
+    rest = rig.skin(rig.rest_pose())
+    for t in np.linspace(0, walk.duration, 8, endpoint=False):
+        v = rig.skin(walk.sample(t))
+        assert abs(v[:, 1].min()) < 0.04 * height
+        assert np.linalg.norm(v - rest, axis=1).max() > 0.02 * height
