@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from .place import least_rotation
@@ -44,6 +45,8 @@ SLENDER = 3.0
 #: them; standing on the ground is what fixes a character's joints vertically.
 FEET = 0.12
 W_FEET = 1.0
+#: Weight pulling a joint that left the mesh back to the nearest medial point.
+W_INSIDE = 10.0
 #: Hold of the scale, against all bones together: a scale 1% off costs as much as every
 #: bone 1% off (firm: it came from the template mesh's height), or a tenth of that (weak:
 #: it came from the skeleton's height, good to 10-20%, so the bones may move it).
@@ -59,7 +62,8 @@ def _chain_of(template, n):
     return owner
 
 
-def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK):
+def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK,
+               medial=None):
     """Solve the embedded chain joints for shape and middle together.
 
     Parameters
@@ -71,6 +75,8 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
     scale : float
     floor : float
         The mesh's ground height (its lowest point).
+    medial : (M, 3) float64, optional
+        Points inside the mesh (the medial spheres' centres) to pull back joints that left it.
     hold_scale : float
         How firmly the scale stays (``W_SCALE_FIRM`` when it came from the template's mesh).
 
@@ -105,6 +111,8 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
     # rows of the form  x[i, dim] - coef * scale = value  (weight w)
     feet = [(i, 1, low[i], floor, W_FEET) for i in np.flatnonzero(low < FEET * span)]
     scale0 = scale
+    medial_tree = cKDTree(medial) if medial is not None and len(medial) else None
+    medial = medial if medial_tree is not None else None
     for _ in range(ROUNDS):
         # each bone turns towards its present direction by how thin its part is: limbs
         # follow the mesh, the trunk keeps the template's directions (frames are shared)
@@ -122,6 +130,13 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
         target = centre_joints(field, x, direction)
         depth = np.maximum(field(target), 0.0)
         lam = W_DATA / (1.0 + (depth / thin) ** 2)
+        if medial is not None:
+            # a joint pushed out of the mesh (a limb shorter than the template's) goes back
+            # to the nearest medial sphere centre, firmly
+            out_ = field(x) < 0.5 * field.h
+            if out_.any():
+                target[out_] = medial[medial_tree.query(x[out_])[1]]
+                lam[out_] = W_INSIDE
         rows = list(feet)
         x, scale = _solve(k, pb, cb, v, lam, target, scale0, rows, hold_scale)
     out = positions.copy()

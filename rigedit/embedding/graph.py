@@ -20,6 +20,8 @@ __all__ = ["MedialGraph", "medial_graph"]
 #: How far apart (in sums of radii) two centres may be and still be joined: beyond touching
 #: spheres, so that a string of small spheres in a tapering limb stays connected.
 REACH = 2.0
+#: Every centre is also offered to its nearest few (then kept if the segment is inside).
+NEAREST = 6
 
 
 @dataclass
@@ -78,12 +80,20 @@ def medial_graph(field, centres, radii):
     if len(pairs):
         gap = np.linalg.norm(centres[pairs[:, 0]] - centres[pairs[:, 1]], axis=1)
         pairs = pairs[gap < REACH * (radii[pairs[:, 0]] + radii[pairs[:, 1]])]
+    # and each centre to its nearest few whatever their radii: where the medial cells thin
+    # out (a tapering leg) the spheres along it may sit further apart than they are wide
+    k = min(NEAREST + 1, n)
+    if k > 1:
+        _, near = tree.query(centres, k=k)
+        extra = np.stack([np.repeat(np.arange(n), k - 1), near[:, 1:].ravel()], axis=1)
+        extra = np.sort(extra, axis=1)
+        pairs = np.unique(np.concatenate([pairs.reshape(-1, 2), extra]), axis=0)
+    pairs = pairs.reshape(-1, 2)
     if len(pairs):
         pairs = pairs[field.segments_inside(centres[pairs[:, 0]], centres[pairs[:, 1]])]
-    lengths = np.linalg.norm(centres[pairs[:, 0]] - centres[pairs[:, 1]], axis=1) if len(
-        pairs) else np.zeros(0)
-    adj = coo_matrix((lengths, (pairs[:, 0], pairs[:, 1])), shape=(n, n)).tocsr() if len(
-        pairs) else coo_matrix((n, n)).tocsr()
+    pairs = _bridge(field, centres, pairs)
+    lengths = np.linalg.norm(centres[pairs[:, 0]] - centres[pairs[:, 1]], axis=1)
+    adj = coo_matrix((lengths, (pairs[:, 0], pairs[:, 1])), shape=(n, n)).tocsr()
     _, label = connected_components(adj, directed=False)
     # Stray spheres (in a separate accessory, an eye) would only distract the search.
     size = np.bincount(label, weights=radii ** 3)
@@ -97,3 +107,43 @@ def medial_graph(field, centres, radii):
     adj = coo_matrix((lengths, (pairs[:, 0], pairs[:, 1])), shape=(m, m)).tocsr()
     dist, pred = dijkstra(adj, directed=False, return_predecessors=True)
     return MedialGraph(centres[keep], radii[keep], np.asarray(pairs, np.int64), dist, pred)
+
+
+def _bridge(field, centres, pairs, tries=8):
+    """Join separate components through the inside where a straight segment allows.
+
+    Where a part is thinner than the grid resolves (a cow's hock at a cell across), the
+    medial cells stop and the spheres on either side are further apart than any sphere's
+    reach; the straight segment between the nearest spheres of the two pieces still runs
+    inside, so it is added. Joins components to the largest one, nearest pairs first.
+    """
+    n = len(centres)
+    added = True
+    while added:
+        added = False
+        adj = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+        count, label = connected_components(adj, directed=False)
+        if count == 1:
+            break
+        sizes = np.bincount(label)
+        main = np.argmax(sizes)
+        in_main = np.flatnonzero(label == main)
+        tree = cKDTree(centres[in_main])
+        k = min(tries, len(in_main))
+        new = []
+        for c in np.argsort(-sizes):
+            if c == main:
+                continue
+            part = np.flatnonzero(label == c)
+            dist, near = tree.query(centres[part], k=k)
+            dist, near = dist.reshape(len(part), k), near.reshape(len(part), k)
+            order = np.argsort(dist, axis=None)[:tries]
+            i, j = np.unravel_index(order, dist.shape)
+            a, b = part[i], in_main[near[i, j]]
+            ok = np.flatnonzero(field.segments_inside(centres[a], centres[b]))
+            if len(ok):
+                new.append(sorted((a[ok[0]], b[ok[0]])))
+        if new:
+            pairs = np.concatenate([pairs, np.asarray(new, dtype=pairs.dtype)])
+            added = True
+    return pairs

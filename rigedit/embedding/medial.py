@@ -69,7 +69,15 @@ def medial_cells(field):
     return pts[medial], depth[tuple(idx[medial].T)]
 
 
-def pack_spheres(centres, radii, min_radius=0.0):
+#: A candidate is dropped when it lies within this fraction of a chosen sphere's radius of
+#: its centre. Pinocchio drops those inside the sphere (1.0); that leaves a thick trunk
+#: with one or two vertices, too few for a hip, a chest and shoulders to find distinct
+#: places, so we pack twice as densely.
+PACK = 0.5
+MAX_SPHERES = 1200
+
+
+def pack_spheres(centres, radii, min_radius=0.0, max_count=None):
     """Greedy packing: deepest candidate first, skipping any inside a chosen sphere.
 
     Parameters
@@ -78,6 +86,10 @@ def pack_spheres(centres, radii, min_radius=0.0):
     radii : (M,) float64
     min_radius : float
         Candidates shallower than this are ignored.
+    max_count : int, optional
+        At most this many spheres (default ``MAX_SPHERES``): the packing loosens until they
+        fit. The search's cost matrices grow with the square of the count; flat, boxy
+        parts (a low-polygon figure) have broad medial sheets that would fill it.
 
     Returns
     -------
@@ -89,13 +101,19 @@ def pack_spheres(centres, radii, min_radius=0.0):
     centres, radii = centres[keep], radii[keep]
     order = np.argsort(-radii, kind="stable")
     centres, radii = centres[order], radii[order]
+    max_count = MAX_SPHERES if max_count is None else max_count
     tree = cKDTree(centres)
-    alive = np.ones(len(centres), dtype=bool)
-    chosen = []
-    for i in range(len(centres)):
-        if not alive[i]:
-            continue
-        chosen.append(i)
-        alive[tree.query_ball_point(centres[i], radii[i])] = False
-    chosen = np.asarray(chosen, dtype=np.int64)
+    pack = PACK
+    while True:
+        alive = np.ones(len(centres), dtype=bool)
+        chosen = []
+        for i in range(len(centres)):
+            if not alive[i]:
+                continue
+            chosen.append(i)
+            alive[tree.query_ball_point(centres[i], pack * radii[i])] = False
+        if len(chosen) <= max_count or pack > 4.0:
+            break
+        pack *= 1.4
+    chosen = np.asarray(chosen[:max_count], dtype=np.int64)
     return centres[chosen], radii[chosen]

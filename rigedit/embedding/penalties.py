@@ -19,16 +19,17 @@ __all__ = ["bone_costs", "joint_costs", "mirror_cost", "W_CARRY", "SEPARATE_RATI
 #: Bone length, as twice the (log ratio)^2 of the chord to the template chord (times the
 #: scale): 3 makes a bone 25% too long or short cost ~0.3: proportions vary between
 #: characters (short legs, long arms) by about that much.
-W_LENGTH = 3.0
+W_LENGTH = 1.0
 #: Allowed excess of a path's detour (log of path over chord) over the template chain's.
 DETOUR = 0.15
 #: Bone direction, times (1 - cos) of the angle to the template chord: 0.6 for 45 degrees
 #: (an A-pose arm against a T-pose template, still acceptable), 2 for a right angle, 4 for
 #: a bone pointing backwards (a leg going up).
-W_DIRECTION = 2.0
+W_DIRECTION = 3.0
 #: Joint height, as the squared difference of the joint's height and the template's, in
 #: quarters of the mesh height: feet low, head high; 0.16 for a tenth of the height off.
 W_HEIGHT = 1.0
+W_HEIGHT_OTHER = 0.0
 #: Symmetry, as the squared distance between a joint and its mirror partner's reflection in
 #: units of 5% of the template's size (scaled): a limb 5% off its mirror costs 0.5.
 W_MIRROR = 0.5
@@ -78,7 +79,7 @@ def bone_costs(points, dist, chord, chain_length, scale):
     return cost
 
 
-def joint_costs(points, template_y, template_floor, floor, height, scale):
+def joint_costs(points, template_y, template_floor, floor, height, scale, foot):
     """(N,) cost of putting a joint at each graph vertex (its height).
 
     Parameters
@@ -91,9 +92,14 @@ def joint_costs(points, template_y, template_floor, floor, height, scale):
     floor, height : float
         The mesh's lowest point and height.
     scale : float
+    foot : bool
+        The joint stands on the ground (an ankle, a hoof): full weight. Other joints get
+        ``W_HEIGHT_OTHER``: characters differ in proportions (short legs, a big head) far
+        more than feet differ in height above the ground.
     """
     expected = scale * (template_y - template_floor)
-    return W_HEIGHT * ((points[:, 1] - floor - expected) / (0.25 * height)) ** 2
+    weight = W_HEIGHT if foot else W_HEIGHT_OTHER
+    return weight * ((points[:, 1] - floor - expected) / (0.25 * height)) ** 2
 
 
 def mirror_cost(p, q, plane_x, unit):

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .fit import FEET
 from .penalties import SEPARATE_RATIO, W_CARRY, bone_costs, joint_costs, mirror_cost
 
 __all__ = ["Search", "discrete_embedding"]
@@ -28,7 +29,7 @@ BRANCH = 48
 #: Radius, in cells, of the thinnest part an optional branch may be embedded in.
 RESOLVED = 2.0
 #: Expansions before the search gives up and keeps the best complete embedding seen.
-MAX_EXPANSIONS = 20000
+MAX_EXPANSIONS = 3000
 
 
 @dataclass
@@ -102,8 +103,10 @@ def discrete_embedding(graph, template, frame, scale, progress=None):
     parent = template.parent
     children = [np.flatnonzero(parent == k) for k in range(r)]
     rest = template.rest[template.joints]
+    span = np.ptp(template.rest[~template.carried, 1])
     unary = np.stack([joint_costs(pts, rest[k, 1], template.floor, frame["floor"],
-                                  frame["height"], scale) for k in range(r)])
+                                  frame["height"], scale,
+                                  rest[k, 1] - template.floor < FEET * span) for k in range(r)])
     # An optional branch goes only where the grid resolves the part (spheres of two cells
     # or more): on a part one cell thin (antlers, ears) the medial graph is too sparse to
     # place it, and carrying it from the template is better than a wrong embedding.
@@ -128,16 +131,21 @@ def discrete_embedding(graph, template, frame, scale, progress=None):
     for a, b in sep:
         partner.setdefault(max(a, b), []).append(min(a, b))
 
+    later_mirror = np.full(r, -1)
+    for k in range(r):
+        if template.mirror[k] > k:
+            later_mirror[k] = template.mirror[k]
     heap = []
     f0 = down[0]
     for v in np.argsort(f0)[:BRANCH]:
         if np.isfinite(f0[v]):
-            heap.append((float(f0[v]), float(unary[0][v]), (int(v),)))
+            heap.append((float(f0[v]), float(unary[0][v]), (int(v),), ()))
     heapq.heapify(heap)
     expansions = 0
     stuck = np.zeros(r, dtype=np.int64)
     while heap:
-        f, g, assign = heapq.heappop(heap)
+        # pending: (joint, bound) pairs already added to f for mirror partners to come
+        f, g, assign, pending = heapq.heappop(heap)
         k = len(assign)
         if k == r:
             return Search(np.asarray(assign), g, expansions)
@@ -147,32 +155,63 @@ def discrete_embedding(graph, template, frame, scale, progress=None):
         if expansions > MAX_EXPANSIONS:
             break
         a = assign[parent[k]]
-        h_rest = f - g - (best[k][a] if a >= 0 else 0.0)
+        own = sum(extra for j, extra in pending if j == k)
+        pending = tuple(p for p in pending if p[0] != k)
+        h_rest = f - g - (best[k][a] if a >= 0 else 0.0) - own
         if a < 0:  # the parent is carried, so is this joint
-            heapq.heappush(heap, (f, g, assign + (-1,)))
+            heapq.heappush(heap, (f - own, g, assign + (-1,), pending))
             continue
         used = np.array([v for v in assign if v >= 0])
-        gk = pair[k][a] + unary[k]
-        m = template.mirror[k]
-        if 0 <= m < k and assign[m] >= 0:
-            gk = gk + mirror_cost(pts, pts[assign[m]], frame["plane_x"], unit)
-        for q in partner.get(k, []):
-            if assign[q] >= 0:
-                apart = np.linalg.norm(pts - pts[assign[q]], axis=1)
-                gk = np.where(dist[assign[q]] >= SEPARATE_RATIO * apart, gk, np.inf)
+        gk = pair[k][a] + unary[k] + _coupling(k, assign, pts, dist, template, partner, frame,
+                                               unit)
         gk[used] = np.inf
         hk = sum((best[c] for c in children[k]), np.zeros(n))
         fk = g + gk + hk + h_rest
         order = np.argsort(fk)[:BRANCH]
         order = order[np.isfinite(fk[order])]
+        m = later_mirror[k]
+        if len(order) and m >= 0 and assign[parent[m]] >= 0:
+            # Tighten the bound with the mirror partner still to come: its best place given
+            # this joint's, mirror and separation terms included (exact for a leaf partner).
+            am = assign[parent[m]]
+            base = pair[m][am] + down[m]
+            extra = np.empty(len(order))
+            for i, v in enumerate(order):
+                trial = assign + (int(v),) + (-2,) * (m - k - 1)
+                cm = base + _coupling(m, trial, pts, dist, template, partner, frame, unit)
+                cm[used] = np.inf
+                cm[v] = np.inf
+                top = np.min(cm)
+                if template.optional[m]:
+                    top = min(top, W_CARRY)
+                extra[i] = top - best[m][am]
+            keep = np.isfinite(extra)
+            order, extra = order[keep], extra[keep]
+        else:
+            extra = np.zeros(len(order))
         if len(order) == 0:
             stuck[k] += 1
-        for v in order:
-            heapq.heappush(heap, (float(fk[v]), float(g + gk[v]), assign + (int(v),)))
+        for v, e in zip(order, extra):
+            heapq.heappush(heap, (float(fk[v] + e), float(g + gk[v]), assign + (int(v),),
+                                  pending + ((m, float(e)),) if e else pending))
         if template.optional[k]:
-            heapq.heappush(heap, (g + W_CARRY + h_rest, g + W_CARRY, assign + (-1,)))
+            heapq.heappush(heap, (g + W_CARRY + h_rest, g + W_CARRY, assign + (-1,), pending))
     return Search(None, np.inf, expansions, failed=int(np.argmax(stuck)) if stuck.any()
                   else _first_unplaceable(best, template))
+
+
+def _coupling(k, assign, pts, dist, template, partner, frame, unit):
+    """(N,) non-tree cost of putting joint ``k`` at each vertex given the placed joints
+    (``assign``; -1 carried, -2 not placed yet): mirror and separation terms."""
+    out = np.zeros(len(pts))
+    m = template.mirror[k]
+    if 0 <= m < len(assign) and assign[m] >= 0:
+        out += mirror_cost(pts, pts[assign[m]], frame["plane_x"], unit)
+    for q in partner.get(k, []):
+        if q < len(assign) and assign[q] >= 0:
+            apart = np.linalg.norm(pts - pts[assign[q]], axis=1)
+            out[dist[assign[q]] < SEPARATE_RATIO * apart] = np.inf
+    return out
 
 
 def _first_unplaceable(best, template):
