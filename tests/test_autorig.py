@@ -306,3 +306,32 @@ def test_cow_as_a_quadruped_walks():
         v = rig.skin(walk.sample(t))
         assert abs(v[:, 1].min()) < 0.04 * height
         assert np.linalg.norm(v - rest, axis=1).max() > 0.02 * height
+
+
+def test_bvh_template_lying_at_rest_is_stood_up_from_its_first_frame():
+    """Bandai's BVH rest lies along one axis: the template pose embedded is the first frame
+    of its clip, turned to face +Z, standing (head over the feet, toes forward)."""
+    bvh = DATA / "bvh-bandai" / "dataset-1_walk_normal_002.bvh"
+    if not bvh.is_file():
+        pytest.skip(f"{bvh} is absent (shared test data)")
+    import warnings
+
+    from rigedit.rigging.autorig import template_poses
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")   # the BVH's guessed units
+        rig, sk, name = load_template(bvh)
+    poses = template_poses(sk, rig, name)
+    posed, source = poses[0]
+    assert source.startswith("frame 0 of ")
+    p = posed.forward(posed.rest_local_matrices())[:, :3, 3]
+    height = np.ptp(p[:, 1])
+    names = posed.names
+    head = p[[i for i, n in enumerate(names) if "head" in n.lower()][0]]
+    toes = [i for i, n in enumerate(names) if "toe" in n.lower()]
+    feet = [posed.parents[i] for i in toes]
+    assert head[1] - p[feet, 1].mean() > 0.7 * height          # standing up
+    assert np.all(p[toes, 2] > p[feet, 2])                       # toes point to +Z
+    # the mesh template keeps its rest, nothing else to try
+    human = rigedit.load_rig("humanoid")
+    assert [s for _, s in template_poses(human.skeleton, human, "humanoid")] == ["rest"]

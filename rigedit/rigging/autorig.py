@@ -33,7 +33,8 @@ from ..errors import RigFileError
 from .mesh_check import check_mesh, read_mesh
 from .orient import Orientation, check_axes, orient
 
-__all__ = ["autorig", "AutorigReport", "load_template", "build_skeleton", "STAGES"]
+__all__ = ["autorig", "AutorigReport", "load_template", "template_poses", "build_skeleton",
+           "STAGES"]
 
 #: Progress bands of the stages (start, end) as fractions of the whole run.
 STAGES = {"load/check": (0.0, 0.05), "orient": (0.05, 0.1), "embedding": (0.1, 0.6),
@@ -63,6 +64,9 @@ class AutorigReport:
         Joints the embedding placed from the mesh (the rest are carried from the template).
     clips : dict[str, str]
         Each template clip -> ``"retargeted"`` or why it was left out.
+    template_pose : str
+        The template pose embedded: ``"rest"``, or a clip's first frame (see
+        :func:`template_poses`).
     """
 
     source: str
@@ -74,6 +78,7 @@ class AutorigReport:
     cost: float = 0.0
     placed: list = field(default_factory=list)
     clips: dict = field(default_factory=dict)
+    template_pose: str = "rest"
 
     def lines(self):
         """The report as short lines (the CLI prints them)."""
@@ -85,8 +90,8 @@ class AutorigReport:
         out.append(f"placed: turned into +Y up, facing +Z, moved by ({t[0]:.4g}, {t[1]:.4g}, "
                    f"{t[2]:.4g}) to stand on y = 0")
         out += list(self.checks.lines())
-        out.append(f"embedding: template {self.template}, {len(self.placed)} joints placed "
-                   f"from the mesh, cost {self.cost:.4g}")
+        out.append(f"embedding: template {self.template} ({self.template_pose} pose), "
+                   f"{len(self.placed)} joints placed from the mesh, cost {self.cost:.4g}")
         for name, how in self.clips.items():
             out.append(f"clip {name}: {how}")
         out.append("seconds: " + ", ".join(f"{k} {v:.2f}" for k, v in self.seconds.items()))
@@ -210,6 +215,55 @@ def build_skeleton(template, positions):
                     deform=template.deform.copy())
 
 
+def template_poses(skeleton, rig, what):
+    """Standing poses of the template to embed, facing +Z, best first: ``[(skeleton, pose)]``.
+
+    The rest pose only, for a template with a mesh or without clips. A motion-only template
+    (a BVH) may have a rest that does not stand as its mesh-less figure would: lying along
+    one axis (Bandai's) or with splayed legs (CMU's). Then the rest, when it stands (the
+    retargeting's calibration finds humanoid limbs, else legs on the floor), and the first
+    frame of its first clip that stands, turned about +Y to face +Z, are offered in turn;
+    :func:`autorig` embeds the first that fits. The clips are retargeted from the template's
+    own rest all the same.
+    """
+    from ..model.skeleton import Skeleton
+    from .calibrate import Calibration
+    from .limbs import LegCalibration
+
+    if rig is None or len(rig.vertices) or not rig.clips:
+        return [(skeleton, "rest")]
+    poses = [("rest", skeleton.forward(skeleton.rest_local_matrices()))]
+    for name in sorted(rig.clips):
+        poses.append((f"frame 0 of {name}",
+                      skeleton.forward(rig.clips[name].sample(0.0).local_matrices())))
+    out = []
+    for source, mats in poses:
+        for kind in (Calibration, LegCalibration):
+            try:
+                cal = kind(skeleton, mats, source, what)
+                break
+            except ValueError:
+                cal = None
+        if cal is None:
+            continue
+        if source == "rest":
+            out.append((skeleton, source))
+        else:
+            fwd = np.asarray(cal.forward, dtype=np.float64)
+            heading = Rotation.from_euler("y", np.arctan2(-fwd[0], fwd[2])).as_matrix()
+            mats = mats.copy()
+            mats[:, :3, :] = heading @ mats[:, :3, :]
+            local = mats.copy()
+            has = skeleton.parents >= 0
+            local[has] = np.linalg.inv(mats[skeleton.parents[has]]) @ mats[has]
+            rot = Rotation.from_matrix(local[:, :3, :3]).as_quat()
+            out.append((Skeleton(list(skeleton.names), skeleton.parents.copy(),
+                                 local[:, :3, 3], rot, deform=skeleton.deform.copy()), source))
+        if len(out) == 2:
+            break
+    return out or [(skeleton, "rest")]
+
+
 def _upright(skeleton):
     """A template stands tall (a biped) when it stands on at most two feet: leaf joints
     within 10% of its height of the lowest joint (a quadruped has four hooves there; its
@@ -277,6 +331,7 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     band("load/check")(0.0)
     check_axes(up, forward)          # a usage error before any file is read
     t_rig, t_sk, t_name = load_template(template)
+    poses = template_poses(t_sk, t_rig, t_name)
     if isinstance(mesh, (str, Path)):
         source = str(mesh)
         vertices, faces = read_mesh(mesh)
@@ -291,7 +346,8 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     t0 = time.perf_counter()
     band("orient")(0.0)
     body_v, body_f = checks.vertices, checks.faces[checks.body]
-    orientation = orient(body_v, body_f, upright=_upright(t_sk), up=up, forward=forward)
+    orientation = orient(body_v, body_f, upright=_upright(poses[0][0]), up=up,
+                         forward=forward)
     place = _placement(vertices, orientation)
     seconds["orient"] = time.perf_counter() - t0
 
@@ -303,11 +359,16 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     t_mesh = None
     if t_rig is not None and len(t_rig.vertices) and len(t_rig.faces):
         t_mesh = (t_rig.skin(t_rig.rest_pose()), t_rig.faces)   # the rest pose's, as the joints
-    try:
-        emb = embed_skeleton(emb_v, remap[body_f], t_sk, progress=band("embedding"),
-                             template_mesh=t_mesh)
-    except EmbeddingError as exc:
-        raise RigFileError(source, f"{exc} (template {t_name}, orientation "
+    emb = first = None
+    for t_sk, t_pose in poses:   # the first standing pose of the template that fits
+        try:
+            emb = embed_skeleton(emb_v, remap[body_f], t_sk, progress=band("embedding"),
+                                 template_mesh=t_mesh)
+            break
+        except EmbeddingError as exc:
+            first = first or exc
+    if emb is None:
+        raise RigFileError(source, f"{first} (template {t_name}, orientation "
                                    f"{orientation.describe()})") from None
     seconds["embedding"] = time.perf_counter() - t0
     for k, v in emb.seconds.items():
@@ -342,6 +403,6 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     band("clips")(1.0)
     seconds["total"] = time.perf_counter() - t_all
     rig.autorig_report = AutorigReport(source, t_name, orientation, place, checks, seconds,
-                                       emb.cost, list(emb.placed), clip_notes)
+                                       emb.cost, list(emb.placed), clip_notes, t_pose)
     rig.notes["autorig"] = (f"template {t_name}; orientation {orientation.describe()}")
     return rig
