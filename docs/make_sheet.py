@@ -47,7 +47,7 @@ def make_sheet(videos, out, n=6):
     if len(widths) != 1:
         raise ValueError(f"expected rows of one width, got {sorted(widths)} pixels")
     sheet = np.concatenate(rows, axis=0)
-    iio.imwrite(out, sheet)
+    iio.imwrite(out, sheet, optimize=True)  # lossless: Pillow tries harder
     return sheet.shape[:2]
 
 
