@@ -84,6 +84,9 @@ def test_map_used_is_shown_and_saved_as_json_the_cli_reads(humanoid_window, qtbo
         assert dialog.table.item(row, 0).text() == name
         assert dialog.combos[row].currentText() == expected.get(name, NONE)
     assert f"{len(expected)} mapped" in dialog.summary.text()
+    unmapped = [n for n in doc.skeleton.names if n not in expected.values()]
+    assert 0 < len(unmapped) <= 8
+    assert dialog.summary.text().endswith(f"kept at their rest pose: {', '.join(unmapped)}.")
     assert dialog.add_button.isEnabled() and not dialog.retarget_button.isEnabled()
 
     out = tmp_path / "walk_map.json"

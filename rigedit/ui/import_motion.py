@@ -52,6 +52,12 @@ def _clip_name(path, source_clip, several):
         return "imported motion"
 
 
+def _names(names, most=8):
+    """``a, b, c`` or ``a, b, ... and 7 more`` (a status line stays short)."""
+    shown = ", ".join(names[:most])
+    return shown if len(names) <= most else f"{shown} and {len(names) - most} more"
+
+
 class ImportMotion:
     """The import of a :class:`~rigedit.ui.main_window.MainWindow` (kept apart from
     :class:`~rigedit.ui.file_actions.FileActions` to keep modules small)."""
@@ -145,8 +151,11 @@ class ImportMotion:
             ctx.summary = (f"joint map {how}, {mapped} mapped, {n_target - mapped} of this "
                            f"character's joints unmapped, {n_source - mapped} of the "
                            f"motion's unused")
+            driven = set(res.mapping.values())
+            rest = [n for n in ctx.skeleton.names if n not in driven]
             text = (f"{ctx.path.name}, clip {ctx.clip!r} ({res.clip.duration:.2f} s): "
-                    f"{ctx.summary}. Unmapped joints of this character keep their rest pose.")
+                    f"{ctx.summary}." + (f" Unmapped, kept at their rest pose: "
+                                         f"{_names(rest)}." if rest else ""))
         dialog = self._dialog(ctx)
         dialog.show_result(None if ctx.res is None else ctx.res.mapping, text)
         dialog.set_busy(False)
