@@ -13,9 +13,14 @@ actor of today against the forty ``vtkSphereWidget`` s it replaced.
 3. The look: the view rendered with the glyphs and with the widgets (same pose, camera and
    everything else), the share of pixels that differ and by how much; ``--save DIR`` writes
    both images.
+4. ``--drag``: only a real drag (profile_drag's: press on the ``fore_cannon_L`` sphere, 120
+   mouse moves through the VTK interactor, release), the wall time per move and this
+   process's CPU time per move. It uses only what every version of the editor has, so that
+   two commits can be compared: ``PYTHONPATH=OLD_TREE xvfb-run ... bench_gizmos.py --drag``
+   then the same with the new tree, in turn.
 
 Run: ``xvfb-run -a -s "-screen 0 1600x1000x24" .venv/bin/python benchmarks/bench_gizmos.py
-[--size 1280x720] [--rounds 15] [--save DIR]``.
+[--size 1280x720] [--rounds 15] [--save DIR] [--drag]``.
 """
 from __future__ import annotations
 
@@ -27,11 +32,13 @@ import warnings
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.append(str(Path(__file__).resolve().parents[1]))  # after PYTHONPATH: see --drag
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
-from profile_drag import _median_ms, open_editor  # noqa: E402
+
+import rigedit  # noqa: E402  (imported before profile_drag puts this tree first on the path)
+from profile_drag import _limb_joint, _median_ms, drag, open_editor  # noqa: E402
 
 
 def wall_and_cpu_ms(fn, n=15, warm=2):
@@ -99,16 +106,29 @@ def compare_look(w, set_widgets, folder=None):
         imageio.imwrite(Path(folder) / "gizmos-widgets.png", widget.astype(np.uint8))
 
 
+def drag_frames(app, w, rounds=3, moves=120):
+    """Wall ms (median) and CPU ms (mean) per mouse move of ``rounds`` real drags."""
+    j = _limb_joint(w.document.skeleton)
+    print(f"rigedit from {Path(rigedit.__file__).parent}")
+    for k in range(rounds):
+        c0 = time.process_time()
+        per_move, renders, _ = drag(app, w, j, moves)
+        cpu = (time.process_time() - c0) / moves * 1e3
+        print(f"  drag {k + 1}: wall {np.median(per_move):.1f} ms per move "
+              f"({1e3 / np.median(per_move):.1f} frames/s), CPU {cpu:.1f} ms per move, "
+              f"{len(renders) / moves:.2f} renders per move")
+        w.document.undo()
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--size", default="1280x720", help="editor window size")
     parser.add_argument("--rounds", type=int, default=15)
     parser.add_argument("--save", help="folder for the two images of the look comparison")
+    parser.add_argument("--drag", action="store_true", help="only time a real drag")
     args = parser.parse_args()
     from PyQt5 import QtWidgets
     from threadpoolctl import threadpool_limits
-
-    import rigedit
 
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication([])
     with warnings.catch_warnings():
@@ -119,6 +139,10 @@ def main():
     with threadpool_limits(1):
         w = open_editor(app, rig, tuple(int(v) for v in args.size.split("x")))
         print(f"3D view {w.plotter.width()}x{w.plotter.height()} px")
+        if args.drag:
+            drag_frames(app, w)
+            w.close()
+            return
         render = w.plotter.render_window.Render
         widgets = old_widgets(w)
         iren = w.plotter.iren.interactor
