@@ -7,11 +7,11 @@ through a hole (or grazed an edge), so it casts no vote; the other two axes deci
 cell is inside when more of its valid votes say so than not, which keeps small holes, cracks
 and several overlapping parts from turning whole slabs of space inside out.
 
-The unsigned distance of a cell is the distance to its nearest point of a sampling of the
-surface (vertices plus points scattered on the faces), found with a k-d tree: a third of a
-cell apart within four cells of the surface, a cell apart deeper in (where a cell's error is
-small against the depth), which is what the medial-surface detection and the sphere radii
-need. Only cells inside or near the surface are measured.
+Within four cells of the surface, the unsigned distance of a cell is the distance to its
+nearest point of a dense sampling of the surface (vertices plus points scattered on the
+faces, a third of a cell apart), found with a k-d tree; deeper in, the Euclidean distance
+transform of the inside mask gives it to about a cell, small against the depth there.
+That is what the medial-surface detection and the sphere radii need.
 """
 from __future__ import annotations
 
@@ -25,7 +25,8 @@ __all__ = ["DistanceField", "distance_field"]
 #: 2 m character at a few cells across, and the whole field under a second at 50k vertices.
 RESOLUTION = 128
 PAD = 3
-#: Cells closer to the surface than this many cells are measured against the dense sampling.
+#: Cells closer to the surface than this many cells are measured against the dense sampling;
+#: deeper ones by the distance transform.
 DENSE_BAND = 4.0
 
 
@@ -182,25 +183,27 @@ def distance_field(vertices, faces, resolution=RESOLUTION, seed=0):
         votes += (parity & valid).astype(np.int16)
         counted += valid.astype(np.int16)
     inside = 2 * votes > counted
-    # Measure cells inside and a band of two cells around them (for interpolation).
-    band = ndimage.binary_dilation(inside, iterations=2)
-    idx = np.argwhere(band)
-    rng = np.random.default_rng(seed)
-    points = origin + idx * h
-    # A coarse sampling (a cell apart) first: deep cells are far from every sample, and a
-    # nearest-neighbour search there visits many leaves of a dense tree. Cells near the
-    # surface, where a cell's worth of error matters, are measured again densely.
-    coarse = _surface_samples(vertices, faces, h, rng)
-    dist, near = cKDTree(coarse).query(points, workers=1)
-    found = coarse[near]
-    close = np.flatnonzero(dist < DENSE_BAND * h)
-    if len(close):
-        dense = _surface_samples(vertices, faces, h / 3.0, rng)
-        d2, n2 = cKDTree(dense).query(points[close], workers=1)
-        dist[close], found[close] = d2, dense[n2]
+    # Deep cells: the Euclidean distance transform of the inside mask (the nearest outside
+    # cell, half a cell short of the surface), exact to about a cell, which is small against
+    # their depth; it costs nothing like a nearest-point search from deep inside a fat body.
+    edt, where = ndimage.distance_transform_edt(inside, return_indices=True)
     depth = np.full(shape, -h)
+    nearest = np.full(shape + (3,), np.nan)
+    deep = inside & (edt > DENSE_BAND)
+    di = np.nonzero(deep)
+    outside_pt = origin + np.stack([w[di] for w in where], axis=1) * h
+    cell_pt = origin + np.stack(di, axis=1) * h
+    away = cell_pt - outside_pt
+    away /= np.maximum(np.linalg.norm(away, axis=1, keepdims=True), 1e-300)
+    depth[di] = (edt[di] - 0.5) * h
+    nearest[di] = outside_pt + 0.5 * h * away
+    # Cells near the surface, inside and in a band of two cells outside (for interpolation):
+    # the nearest of a dense sampling of the surface, a third of a cell apart.
+    band = ndimage.binary_dilation(inside, iterations=2) & ~deep
+    idx = np.argwhere(band)
+    dense = _surface_samples(vertices, faces, h / 3.0, np.random.default_rng(seed))
+    dist, near = cKDTree(dense).query(origin + idx * h, workers=1)
     sign = np.where(inside[tuple(idx.T)], 1.0, -1.0)
     depth[tuple(idx.T)] = sign * dist
-    nearest = np.full(shape + (3,), np.nan)
-    nearest[tuple(idx.T)] = found
+    nearest[tuple(idx.T)] = dense[near]
     return DistanceField(origin, h, depth, inside, nearest)

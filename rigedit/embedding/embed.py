@@ -165,7 +165,7 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None)
     hold = W_SCALE_FIRM if np.isfinite(reduced.height) else W_SCALE_WEAK
     chains = place_chains(reduced, positions, paths)
     out, scale = stage("refinement", 0.95, fit_joints, field_, reduced, chains, scale,
-                       frame["floor"], hold, graph.points)
+                       frame["floor"], hold, graph.points, frame["plane_x"])
     out = stage("placement", 1.0, place_carried, reduced, out, scale)
     placed_mask = np.zeros(len(out), dtype=bool)
     for r in np.flatnonzero(ok):

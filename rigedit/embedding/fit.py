@@ -47,6 +47,9 @@ FEET = 0.12
 W_FEET = 1.0
 #: Weight pulling a joint that left the mesh back to the nearest medial point.
 W_INSIDE = 10.0
+#: Left-right symmetry, per coordinate: half a bone's weight, so that an asymmetric pose
+#: (one arm raised) still follows the mesh while a symmetric one comes out symmetric.
+W_MIRROR_FIT = 0.5
 #: Hold of the scale, against all bones together: a scale 1% off costs as much as every
 #: bone 1% off (firm: it came from the template mesh's height), or a tenth of that (weak:
 #: it came from the skeleton's height, good to 10-20%, so the bones may move it).
@@ -63,7 +66,7 @@ def _chain_of(template, n):
 
 
 def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK,
-               medial=None):
+               medial=None, plane=None):
     """Solve the embedded chain joints for shape and middle together.
 
     Parameters
@@ -75,6 +78,9 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
     scale : float
     floor : float
         The mesh's ground height (its lowest point).
+    plane : float, optional
+        The mesh's middle plane x = plane: left and right joints mirror each other across
+        it and middle joints lie on it (``W_MIRROR_FIT``); no symmetry rows without it.
     medial : (M, 3) float64, optional
         Points inside the mesh (the medial spheres' centres) to pull back joints that left it.
     hold_scale : float
@@ -109,7 +115,8 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
     # feet: (slot, template height above the template's ground)
     low = rest[idx, 1] - template.floor
     # rows of the form  x[i, dim] - coef * scale = value  (weight w)
-    feet = [(i, 1, low[i], floor, W_FEET) for i in np.flatnonzero(low < FEET * span)]
+    rows = [([(i, 1, 1.0)], low[i], floor, W_FEET) for i in np.flatnonzero(low < FEET * span)]
+    rows += _symmetry_rows(template, idx, slot, plane)
     scale0 = scale
     medial_tree = cKDTree(medial) if medial is not None and len(medial) else None
     medial = medial if medial_tree is not None else None
@@ -137,16 +144,51 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
             if out_.any():
                 target[out_] = medial[medial_tree.query(x[out_])[1]]
                 lam[out_] = W_INSIDE
-        rows = list(feet)
         x, scale = _solve(k, pb, cb, v, lam, target, scale0, rows, hold_scale)
+    if medial is not None:
+        x = _step_inside(field, x, medial[medial_tree.query(x)[1]])
     out = positions.copy()
     out[idx] = x
     return out, scale
 
 
+def _step_inside(field, points, towards, steps=16):
+    """Points outside the mesh moved along the segment towards ``towards`` (inside points,
+    one per point) to the first place a quarter cell deep; points inside stay."""
+    points = np.array(points, dtype=np.float64)
+    out_ = np.flatnonzero(field(points) <= 0.0)
+    if len(out_):
+        t = np.linspace(0.0, 1.0, steps + 1)
+        a, b = points[out_], towards[out_]
+        path = a[:, None, :] + t[None, :, None] * (b - a)[:, None, :]
+        deep = field(path.reshape(-1, 3)).reshape(len(out_), -1) > 0.25 * field.h
+        first = np.where(deep.any(axis=1), deep.argmax(axis=1), steps)
+        points[out_] = path[np.arange(len(out_)), first]
+    return points
+
+
+def _symmetry_rows(template, idx, slot, plane):
+    """Rows tying mirror joints (x_a + x_b = 2 plane, equal y and z) and middle joints
+    (x = plane)."""
+    if plane is None:
+        return []
+    rows = []
+    live = set(idx.tolist())
+    for j in idx:
+        m = template.mirror_all[j]
+        if m > j and m in live:
+            a, b = slot[j], slot[m]
+            rows.append(([(a, 0, 1.0), (b, 0, 1.0)], 0.0, 2.0 * plane, W_MIRROR_FIT))
+            rows += [([(a, d, 1.0), (b, d, -1.0)], 0.0, 0.0, W_MIRROR_FIT) for d in (1, 2)]
+        elif m == -2:
+            rows.append(([(slot[j], 0, 1.0)], 0.0, plane, W_MIRROR_FIT))
+    return rows
+
+
 def _solve(k, pb, cb, v, lam, target, scale, extra, hold_scale):
     """Least squares in joints (k, 3) and scale: bones = scale * v, joints = targets, and
-    ``extra`` rows (slot, dim, coef, value, weight): x[slot, dim] - coef * scale = value."""
+    ``extra`` rows (entries, coef, value, weight): sum of c * x[slot, dim] over the
+    entries (slot, dim, c), minus coef * scale, = value."""
     nb = len(pb)
     a = np.zeros((3 * nb + 3 * k + 1 + len(extra), 3 * k + 1))
     rhs = np.zeros(len(a))
@@ -163,8 +205,9 @@ def _solve(k, pb, cb, v, lam, target, scale, extra, hold_scale):
     hold = hold_scale * float(np.linalg.norm(v))
     a[3 * nb + 3 * k, -1] = hold
     rhs[3 * nb + 3 * k] = hold * scale
-    for row, (i, dim, coef, value, w) in enumerate(extra, start=3 * nb + 3 * k + 1):
-        a[row, 3 * i + dim] = w
+    for row, (entries, coef, value, w) in enumerate(extra, start=3 * nb + 3 * k + 1):
+        for i, dim, c in entries:
+            a[row, 3 * i + dim] = w * c
         a[row, -1] = -w * coef
         rhs[row] = w * value
     sol = np.linalg.lstsq(a, rhs, rcond=None)[0]

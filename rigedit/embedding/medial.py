@@ -42,31 +42,34 @@ def medial_cells(field):
     """
     depth, h = field.depth, field.h
     deep = field.inside & (depth > MIN_DEPTH_CELLS * h)
-    idx = np.argwhere(deep)
-    pts = field.points(idx)
-    near = field.nearest[tuple(idx.T)]
-    dep = depth[tuple(idx.T)]
-    grad = pts - near
-    grad /= np.maximum(np.linalg.norm(grad, axis=1, keepdims=True), 1e-300)
-    full = np.zeros(depth.shape + (3,))
-    full[tuple(idx.T)] = grad
-    medial = np.zeros(len(idx), dtype=bool)
-    shape = np.array(depth.shape)
+    if not deep.any():
+        return np.zeros((0, 3)), np.zeros(0)
+    # work on the box around the deep cells, with whole-array shifts per neighbour direction
+    box = tuple(slice(lo, hi + 1) for lo, hi in zip(np.argwhere(deep).min(0),
+                                                     np.argwhere(deep).max(0)))
+    deep = deep[box]
+    dep = np.where(deep, depth[box], 0.0)
+    near = np.where(deep[..., None], field.nearest[box], 0.0)
+    grid = np.stack(np.meshgrid(*[np.arange(b.start, b.stop) for b in box], indexing="ij"), -1)
+    grad = field.origin + grid * h - near
+    grad /= np.maximum(np.linalg.norm(grad, axis=-1, keepdims=True), 1e-300)
+    medial = np.zeros(deep.shape, dtype=bool)
+
+    def cut(step, first):
+        return tuple(slice(None) if d == 0 else (slice(0, -1) if (d > 0) == first
+                                                 else slice(1, None)) for d in step)
+
     for step in ((1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 0), (1, -1, 0), (1, 0, 1),
                  (1, 0, -1), (0, 1, 1), (0, 1, -1)):
-        for sign in (1, -1):
-            nb = idx + sign * np.array(step)
-            ok = np.all((nb >= 0) & (nb < shape), axis=1)
-            g = np.zeros_like(grad)
-            g[ok] = full[tuple(nb[ok].T)]
-            inside_nb = np.zeros(len(idx), dtype=bool)
-            inside_nb[ok] = deep[tuple(nb[ok].T)]
-            cos = np.einsum("ij,ij->i", grad, g)
-            near_nb = np.zeros_like(grad)
-            near_nb[ok] = field.nearest[tuple(nb[ok].T)]
-            apart = np.linalg.norm(near_nb - near, axis=1)
-            medial |= inside_nb & (cos < MEDIAL_COS) & (apart > SEPARATION * dep)
-    return pts[medial], depth[tuple(idx[medial].T)]
+        a, b = cut(step, True), cut(step, False)
+        both = deep[a] & deep[b]
+        cos = np.einsum("...k,...k->...", grad[a], grad[b])
+        apart = np.linalg.norm(near[a] - near[b], axis=-1)
+        jump = both & (cos < MEDIAL_COS)
+        medial[a] |= jump & (apart > SEPARATION * dep[a])
+        medial[b] |= jump & (apart > SEPARATION * dep[b])
+    cells = np.argwhere(medial) + np.array([b.start for b in box])
+    return field.points(cells), depth[tuple(cells.T)]
 
 
 #: A candidate is dropped when it lies within this fraction of a chosen sphere's radius of

@@ -63,6 +63,8 @@ class ReducedTemplate:
         The reduced joint it mirrors (-1: none, or itself on the middle plane).
     carried : (J,) bool
         Template joints never embedded.
+    mirror_all : (J,) int
+        Every template joint's mirror image (-1: none; -2: on the middle plane).
     """
 
     rest: np.ndarray
@@ -78,6 +80,7 @@ class ReducedTemplate:
     optional: np.ndarray
     mirror: np.ndarray
     carried: np.ndarray
+    mirror_all: np.ndarray = None
 
     def label(self, skeleton, r):
         """A human name for reduced joint ``r``'s chain ("left arm (LeftHand)")."""
@@ -174,6 +177,9 @@ def reduce_template(skeleton, mesh=None):
         length[r] = sum(bone[c] for c in chain[:-1])
     optional = _optional(parent, length)
     mirror = _mirror(rest[reduced], rest[reduced[0]], size)
+    mirror_all = _mirror(rest, rest[reduced[0]], size)
+    middle = np.abs(rest[:, 0] - rest[reduced[0], 0]) < 0.02 * size
+    mirror_all[(mirror_all < 0) & middle] = -2
     kept_y = rest[kept, 1]
     floor = float(kept_y.min() - ANKLE_HEIGHT * np.ptp(kept_y))
     height = area = np.nan
@@ -182,7 +188,7 @@ def reduce_template(skeleton, mesh=None):
         floor, height = float(verts[:, 1].min()), float(np.ptp(verts[:, 1]))
         area = surface_area(verts, mesh[1])
     return ReducedTemplate(rest, parents.copy(), size, floor, height, area, np.asarray(reduced),
-                           parent, chains, length, optional, mirror, carried)
+                           parent, chains, length, optional, mirror, carried, mirror_all)
 
 
 def surface_area(vertices, faces):

@@ -1,0 +1,319 @@
+"""Skeleton embedding (rigedit.embedding): accuracy by CD-J2J, invariance, bad input, cancel.
+
+Limits are about 1.5 times what was measured on this machine (the measured value is noted
+beside each); the issue's targets are under 2% on the bundled characters' own meshes and at
+most 4% on every test mesh. Heavy inputs are built once per module.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rigedit
+from rigedit.embedding import Embedding, EmbeddingError, cd_j2j, embed_skeleton
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+
+
+# ------------------------------------------------------------------------------ helpers
+def _diagonal(vertices):
+    return float(np.linalg.norm(np.ptp(vertices, axis=0)))
+
+
+def _posed(rig, angles):
+    """The rig skinned in a pose (Euler degrees per joint) and its joints, feet on the floor."""
+    pose = rig.rest_pose()
+    for joint, euler in angles.items():
+        pose.set_euler(joint, euler, degrees=True)
+    vertices = np.array(rig.skin(pose))
+    joints = rig.joint_matrices(pose)[:, :3, 3].copy()
+    drop = vertices[:, 1].min() - rig.vertices[:, 1].min()
+    vertices[:, 1] -= drop
+    joints[:, 1] -= drop
+    return vertices, joints
+
+
+def _subdivide(vertices, faces):
+    """One midpoint subdivision (each triangle into four), shared edge midpoints."""
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), 1)
+    unique, inverse = np.unique(edges, axis=0, return_inverse=True)
+    mid = len(vertices) + inverse.reshape(3, -1).T                     # (F, 3): ab, bc, ca
+    out_v = np.concatenate([vertices, vertices[unique].mean(axis=1)])
+    a, b, c = faces.T
+    ab, bc, ca = mid.T
+    out_f = np.concatenate([np.c_[a, ab, ca], np.c_[ab, b, bc], np.c_[ca, bc, c], np.c_[ab, bc, ca]])
+    return out_v, out_f
+
+
+def _uv_sphere(n=32, m=16):
+    theta = np.linspace(0, np.pi, m + 1)[1:-1]
+    phi = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    ring = np.c_[(np.sin(t) * np.cos(p)).ravel(), np.cos(t).ravel(), (np.sin(t) * np.sin(p)).ravel()]
+    v = np.concatenate([[[0, 1.0, 0]], ring, [[0, -1.0, 0]]])
+    f = [[0, 1 + (j + 1) % n, 1 + j] for j in range(n)]
+    for i in range(m - 2):
+        for j in range(n):
+            a, b = 1 + i * n + j, 1 + i * n + (j + 1) % n
+            f += [[a, b, b + n], [a, b + n, a + n]]
+    base, last = 1 + (m - 2) * n, len(v) - 1
+    f += [[last, base + j, base + (j + 1) % n] for j in range(n)]
+    return v, np.array(f)
+
+
+def _box(sx, sy, sz):
+    v = np.array([[x, y, z] for x in (-sx / 2, sx / 2) for y in (0, sy) for z in (-sz / 2, sz / 2)])
+    f = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    return v, f
+
+
+def _shared(*parts):
+    path = DATA.joinpath(*parts)
+    if not DATA.is_dir():
+        pytest.skip(f"{DATA} is absent (shared third-party test data)")
+    return path
+
+
+# ------------------------------------------------------------------------------ fixtures
+@pytest.fixture(scope="module")
+def humanoid():
+    return rigedit.load_rig("humanoid")
+
+
+@pytest.fixture(scope="module")
+def quadruped():
+    return rigedit.load_rig("quadruped")
+
+
+def _embed(rig_or_mesh, template_rig, use_mesh=True, **kw):
+    vertices, faces = rig_or_mesh
+    mesh = (template_rig.vertices, template_rig.faces) if use_mesh else None
+    return embed_skeleton(vertices, faces, template_rig.skeleton, template_mesh=mesh, **kw)
+
+
+@pytest.fixture(scope="module")
+def own_humanoid(humanoid):
+    return _embed((humanoid.vertices, humanoid.faces), humanoid)
+
+
+# ------------------------------------------------------------------------------ cd_j2j
+def test_cd_j2j_is_the_symmetric_mean_nearest_distance_in_percent():
+    truth = np.array([[0.0, 0, 0], [1.0, 0, 0]])
+    assert cd_j2j(truth, truth, 2.0) == 0.0
+    # one predicted joint 0.1 off the first true joint and one exactly on the second:
+    # predicted->truth mean 0.05, truth->predicted mean 0.05, average 0.05 -> 2.5% of 2.0
+    pred = np.array([[0.1, 0, 0], [1.0, 0, 0]])
+    assert cd_j2j(pred, truth, 2.0) == pytest.approx(2.5)
+    # asymmetric sets: a single prediction at the origin against both true joints
+    assert cd_j2j(np.zeros((1, 3)), truth, 1.0) == pytest.approx(100 * 0.5 * (0.0 + 0.5))
+    with pytest.raises(ValueError, match="diagonal"):
+        cd_j2j(pred, truth, 0.0)
+
+
+# ------------------------------------------------------------------------------ the API
+def test_every_template_joint_is_returned_with_stage_times(own_humanoid, humanoid):
+    emb = own_humanoid
+    skeleton = humanoid.skeleton
+    assert isinstance(emb, Embedding)
+    assert emb.positions.shape == (len(skeleton), 3)
+    assert np.all(np.isfinite(emb.positions))
+    assert set(emb.placed) <= set(skeleton.names)
+    # the limbs come from the mesh; the ground-level root and the toes are carried
+    assert {"Hips", "LeftHand", "RightFoot", "LeftForeArm"} <= set(emb.placed)
+    assert "root" not in emb.placed and "LeftToeBase" not in emb.placed
+    for stage in ("distance field", "search", "refinement"):
+        assert emb.seconds[stage] >= 0.0
+    assert np.isfinite(emb.cost)
+
+
+# ------------------------------------------------------------------------------ accuracy
+def test_bundled_humanoid_on_its_own_mesh(own_humanoid, humanoid):
+    truth = humanoid.skeleton.bind_matrices[:, :3, 3]
+    cd = cd_j2j(own_humanoid.positions, truth, _diagonal(humanoid.vertices))
+    assert cd < 0.2  # measured 0.13%
+
+
+def test_bundled_quadruped_on_its_own_mesh(quadruped):
+    emb = _embed((quadruped.vertices, quadruped.faces), quadruped)
+    truth = quadruped.skeleton.bind_matrices[:, :3, 3]
+    assert cd_j2j(emb.positions, truth, _diagonal(quadruped.vertices)) < 1.1  # measured 0.73%
+
+
+def test_without_the_template_mesh_scale_and_ground_are_estimated(humanoid, quadruped):
+    for rig, limit in ((humanoid, 0.3), (quadruped, 3.2)):  # measured 0.13% and 2.11%
+        emb = _embed((rig.vertices, rig.faces), rig, use_mesh=False)
+        truth = rig.skeleton.bind_matrices[:, :3, 3]
+        assert cd_j2j(emb.positions, truth, _diagonal(rig.vertices)) < limit, rig.name
+
+
+POSES = {
+    # (rig, name): (angles, limit in %, measured)
+    ("humanoid", "A-pose"): ({"LeftArm": [0, 0, -45], "RightArm": [0, 0, 45]}, 3.0),  # 1.95
+    ("humanoid", "legs apart"): ({"LeftUpLeg": [0, 0, 15], "RightUpLeg": [0, 0, -15]},
+                                 0.9),  # 0.55
+    ("humanoid", "crouch"): ({"LeftUpLeg": [-30, 0, 0], "RightUpLeg": [-30, 0, 0],
+                              "LeftLeg": [50, 0, 0], "RightLeg": [50, 0, 0],
+                              "LeftFoot": [-20, 0, 0], "RightFoot": [-20, 0, 0],
+                              "Spine": [10, 0, 0]}, 3.3),  # 2.20
+    ("quadruped", "head down"): ({"neck_1": [25, 0, 0]}, 4.0),  # 3.01 (target 4%)
+    ("quadruped", "crouch"): ({"hind_thigh_L": [-15, 0, 0], "hind_thigh_R": [-15, 0, 0],
+                               "hind_shin_L": [20, 0, 0], "hind_shin_R": [20, 0, 0],
+                               "fore_upper_L": [15, 0, 0], "fore_upper_R": [15, 0, 0],
+                               "fore_lower_L": [-20, 0, 0], "fore_lower_R": [-20, 0, 0]},
+                              1.7),  # 1.13
+}
+
+
+@pytest.mark.parametrize("key", list(POSES), ids=[f"{a}-{b}" for a, b in POSES])
+def test_posed_bundled_characters_against_their_posed_joints(key, humanoid, quadruped):
+    """The rest-pose template embedded in the character skinned in another pose finds the
+    posed joints (truth: the pose's joint positions)."""
+    rig = humanoid if key[0] == "humanoid" else quadruped
+    angles, limit = POSES[key]
+    vertices, truth = _posed(rig, angles)
+    emb = _embed((vertices, rig.faces), rig)
+    assert cd_j2j(emb.positions, truth, _diagonal(vertices)) < limit
+
+
+LEGS = {"LeftUpLeg": "leg_joint_L_1", "LeftLeg": "leg_joint_L_2", "LeftFoot": "leg_joint_L_3",
+        "LeftToeBase": "leg_joint_L_5", "RightUpLeg": "leg_joint_R_1",
+        "RightLeg": "leg_joint_R_2", "RightFoot": "leg_joint_R_3",
+        "RightToeBase": "leg_joint_R_5"}
+#: The bundled humanoid's joints -> the artists' joints (by anatomy: hip, knee, ankle, toe;
+#: pelvis, lower torso, chest, neck base, skull base; shoulder, elbow, wrist). Template
+#: joints with no counterpart (the clavicles, Spine1) are left out of the measure.
+KHRONOS = {
+    "CesiumMan.glb": dict(
+        LEGS, Hips="Skeleton_torso_joint_1", Spine="Skeleton_torso_joint_2",
+        Spine2="torso_joint_3", Neck="Skeleton_neck_joint_1", Head="Skeleton_neck_joint_2",
+        LeftArm="Skeleton_arm_joint_L__4_", LeftForeArm="Skeleton_arm_joint_L__3_",
+        LeftHand="Skeleton_arm_joint_L__2_", RightArm="Skeleton_arm_joint_R",
+        RightForeArm="Skeleton_arm_joint_R__2_", RightHand="Skeleton_arm_joint_R__3_"),
+    "RiggedFigure.glb": dict(
+        LEGS, Hips="torso_joint_1", Spine="torso_joint_2", Spine2="torso_joint_3",
+        Neck="neck_joint_1", Head="neck_joint_2", LeftArm="arm_joint_L_1",
+        LeftForeArm="arm_joint_L_2", LeftHand="arm_joint_L_3", RightArm="arm_joint_R_1",
+        RightForeArm="arm_joint_R_2", RightHand="arm_joint_R_3"),
+}
+
+
+def _khronos(name):
+    rig = rigedit.load_rig(str(_shared("khronos-gltf", name)))
+    rest = rig.rest_pose()
+    # at the rest pose these files stand +Y up, facing +Z, left at +X: rigedit's frame
+    return np.array(rig.skin(rest)), rig.faces, rig.joint_matrices(rest)[:, :3, 3], rig
+
+
+@pytest.mark.parametrize("name,limit", [("CesiumMan.glb", 4.0),   # measured 3.07% (target 4%)
+                                        ("RiggedFigure.glb", 4.0)])  # measured 3.04%
+def test_khronos_humanoids_with_the_humanoid_template(name, limit, humanoid):
+    vertices, faces, joints, rig = _khronos(name)
+    table = KHRONOS[name]
+    emb = _embed((vertices, faces), humanoid)
+    pred = np.array([emb.positions[humanoid.skeleton.index[k]] for k in table])
+    truth = np.array([joints[rig.skeleton.index[v]] for v in table.values()])
+    assert cd_j2j(pred, truth, _diagonal(vertices)) < limit
+
+
+def test_a_subdivided_mesh_gives_the_same_skeleton(humanoid):
+    vertices, faces, joints, rig = _khronos("CesiumMan.glb")
+    coarse = _embed((vertices, faces), humanoid)
+    fine_v, fine_f = _subdivide(vertices, faces)
+    assert len(fine_f) == 4 * len(faces)
+    fine = _embed((fine_v, fine_f), humanoid)
+    # the same surface, four times the triangles: the joints hardly move
+    assert cd_j2j(fine.positions, coarse.positions, _diagonal(vertices)) < 1.0  # measured 0.4%
+    table = KHRONOS["CesiumMan.glb"]
+    pred = np.array([fine.positions[humanoid.skeleton.index[k]] for k in table])
+    truth = np.array([joints[rig.skeleton.index[v]] for v in table.values()])
+    assert cd_j2j(pred, truth, _diagonal(vertices)) < 4.0  # measured 2.89%
+
+
+def test_scale_and_translation_carry_through(own_humanoid, humanoid):
+    rng = np.random.default_rng(7)
+    scale = float(rng.uniform(0.05, 20.0))
+    shift = rng.uniform(-50, 50, size=3)
+    moved = humanoid.vertices * scale + shift
+    emb = embed_skeleton(moved, humanoid.faces, humanoid.skeleton,
+                         template_mesh=(humanoid.vertices, humanoid.faces))
+    expected = own_humanoid.positions * scale + shift
+    err = np.linalg.norm(emb.positions - expected, axis=1).max() / _diagonal(moved)
+    assert err < 1e-3
+    assert emb.scale == pytest.approx(own_humanoid.scale * scale, rel=1e-3)
+
+
+# ------------------------------------------------------------------------------ other meshes
+def _inside_fraction(points, vertices, faces):
+    from rigedit.embedding.distance import distance_field
+    field = distance_field(vertices, faces)
+    return float(np.mean(field(points) > 0))
+
+
+def test_cow_with_the_quadruped_template_has_four_legs_in_place(quadruped):
+    from rigedit.io.mesh import load_mesh
+
+    vertices, faces = load_mesh(_shared("common-3d-test-models", "cow.obj"))
+    vertices = np.c_[-vertices[:, 2], vertices[:, 1], vertices[:, 0]]  # faces +X -> +Z
+    emb = _embed((vertices, faces), quadruped)
+    p = {n: emb.positions[j] for j, n in enumerate(quadruped.skeleton.names)}
+    floor, height = vertices[:, 1].min(), np.ptp(vertices[:, 1])
+    hooves = ["fore_hoof_L", "fore_hoof_R", "hind_hoof_L", "hind_hoof_R"]
+    for h in hooves:
+        assert p[h][1] - floor < 0.12 * height, h
+    assert p["fore_hoof_L"][2] > p["hind_hoof_L"][2] + 0.3 * height
+    assert p["fore_hoof_L"][0] > p["fore_hoof_R"][0] and p["hind_hoof_L"][0] > p["hind_hoof_R"][0]
+    assert p["head"][2] > p["spine_3"][2] > p["pelvis"][2]
+    assert p["head"][1] > p["pelvis"][1]
+    placed = [j for j, n in enumerate(quadruped.skeleton.names) if n in emb.placed]
+    assert _inside_fraction(emb.positions[placed], vertices, faces) > 0.95
+
+
+def test_homer_with_the_humanoid_template_stands_in_the_body(humanoid):
+    from rigedit.io.mesh import load_mesh
+
+    vertices, faces = load_mesh(_shared("common-3d-test-models", "homer.obj"))
+    emb = _embed((vertices, faces), humanoid)  # homer is +Y up, facing +Z already
+    p = {n: emb.positions[j] for j, n in enumerate(humanoid.skeleton.names)}
+    floor, height = vertices[:, 1].min(), np.ptp(vertices[:, 1])
+    for foot in ("LeftFoot", "RightFoot"):
+        assert p[foot][1] - floor < 0.12 * height
+    assert p["LeftHand"][0] > p["LeftArm"][0] > p["Spine2"][0] > p["RightArm"][0] > p["RightHand"][0]
+    assert p["Head"][1] > p["Spine2"][1] > p["Hips"][1] > p["LeftLeg"][1] > p["LeftFoot"][1]
+    placed = [j for j, n in enumerate(humanoid.skeleton.names) if n in emb.placed]
+    assert _inside_fraction(emb.positions[placed], vertices, faces) > 0.95
+
+
+# ------------------------------------------------------------------------------ bad input
+@pytest.mark.parametrize("shape", ["sphere", "box"])
+def test_a_blob_without_limbs_is_refused_naming_what_is_missing(shape, humanoid):
+    vertices, faces = _uv_sphere() if shape == "sphere" else _box(0.6, 1.8, 0.3)
+    with pytest.raises(EmbeddingError, match=r"no place found for the template's .*\(\w+\)"):
+        embed_skeleton(vertices, faces, humanoid.skeleton)
+    assert issubclass(EmbeddingError, ValueError)
+
+
+def test_malformed_arrays_are_refused(humanoid):
+    with pytest.raises(EmbeddingError, match="expected"):
+        embed_skeleton(np.zeros((3, 3)), np.zeros((1, 3), int), humanoid.skeleton)
+    v, f = _box(1, 1, 1)
+    with pytest.raises(EmbeddingError, match="face indices"):
+        embed_skeleton(v, f + 100, humanoid.skeleton)
+
+
+def test_progress_reports_and_an_exception_from_it_cancels(humanoid):
+    seen = []
+
+    class Cancelled(Exception):
+        pass
+
+    def progress(fraction):
+        seen.append(fraction)
+        if len(seen) == 3:
+            raise Cancelled
+
+    with pytest.raises(Cancelled):
+        embed_skeleton(humanoid.vertices, humanoid.faces, humanoid.skeleton, progress=progress)
+    assert seen == sorted(seen) and seen[0] == 0.0 and len(seen) == 3
