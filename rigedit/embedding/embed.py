@@ -166,7 +166,7 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None)
     chains = place_chains(reduced, positions, paths)
     out, scale = stage("refinement", 0.95, fit_joints, field_, reduced, chains, scale,
                        frame["floor"], hold, graph.points, frame["plane_x"])
-    out = stage("placement", 1.0, place_carried, reduced, out, scale)
+    out = stage("placement", 1.0, place_carried, reduced, out, scale, frame["floor"])
     placed_mask = np.zeros(len(out), dtype=bool)
     for r in np.flatnonzero(ok):
         placed_mask[reduced.chains[r][1:] if r else [reduced.joints[0]]] = True

@@ -45,6 +45,9 @@ SLENDER = 3.0
 #: them; standing on the ground is what fixes a character's joints vertically.
 FEET = 0.12
 W_FEET = 1.0
+#: Chains keep the template's proportions unless the embedded chord differs by more than
+#: this (log ratio, ~16%); beyond it they take the excess (see ``_proportions``).
+PROPORTION_FREE = 0.15
 #: Weight pulling a joint that left the mesh back to the nearest medial point.
 W_INSIDE = 10.0
 #: Left-right symmetry, per coordinate: half a bone's weight, so that an asymmetric pose
@@ -111,6 +114,7 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
     pb = np.array([slot[p] for p, _ in bones])
     cb = np.array([slot[j] for _, j in bones])
     tb = np.array([rest[j] - rest[p] for p, j in bones])
+    tb *= _proportions(template, positions, scale)[[owner[j] for _, j in bones]][:, None]
     span = np.ptp(rest[idx, 1])
     # feet: (slot, template height above the template's ground)
     low = rest[idx, 1] - template.floor
@@ -150,6 +154,27 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
     out = positions.copy()
     out[idx] = x
     return out, scale
+
+
+def _proportions(template, positions, scale):
+    """(R,) length factor of each reduced chain: its embedded chord over the scaled template
+    chord, outside a dead zone of +-``PROPORTION_FREE`` (log) and clipped to [0.6, 1.6].
+
+    The discrete embedding puts chain ends where the mesh has them (hands at the ends of
+    arms); a character whose arms or legs are much shorter or longer than the template's
+    keeps that here, while the small differences (a chain end a few centimetres off on a
+    sparse graph) leave the template's proportions alone."""
+    rest = template.rest
+    out = np.ones(len(template.joints))
+    for r in range(1, len(template.joints)):
+        a, b = template.chains[r][0], template.chains[r][-1]
+        if np.all(np.isfinite(positions[[a, b]])):
+            ratio = np.linalg.norm(positions[b] - positions[a]) / max(
+                scale * np.linalg.norm(rest[b] - rest[a]), 1e-12)
+            excess = np.log(max(ratio, 1e-12))
+            excess = np.sign(excess) * max(abs(excess) - PROPORTION_FREE, 0.0)
+            out[r] = np.clip(np.exp(excess), 0.6, 1.6)
+    return out
 
 
 def _step_inside(field, points, towards, steps=16):

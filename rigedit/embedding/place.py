@@ -85,13 +85,13 @@ def place_chains(template, reduced, paths=None, bend=0.5):
     return out
 
 
-def place_carried(template, positions, scale):
+def place_carried(template, positions, scale, floor=None):
     """Fill in the carried joints from the placed ones.
 
     Each keeps its template offset from its nearest placed ancestor, scaled, and turned like
     that ancestor's own bone (the least rotation from its template bone to its placed bone);
     a joint above every placed one (a ground-level root) keeps its offset from the reduced
-    root, unturned.
+    root, unturned, but its height above the ground (``floor``, the mesh's lowest point).
 
     Parameters
     ----------
@@ -99,6 +99,7 @@ def place_carried(template, positions, scale):
     positions : (J, 3) float64
         NaN rows for the joints to place.
     scale : float
+    floor : float, optional
 
     Returns
     -------
@@ -117,6 +118,8 @@ def place_carried(template, positions, scale):
             p = parents[p]
         if p < 0:
             out[j] = out[root] + scale * (rest[j] - rest[root])
+            if floor is not None:  # keep its height above the ground (a ground-level root)
+                out[j, 1] = floor + scale * (rest[j, 1] - template.floor)
             continue
         if p not in turn:
             q = parents[p]
