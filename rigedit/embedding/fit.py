@@ -1,18 +1,26 @@
-"""Fitting every embedded joint at once: the template's shape against the mesh's middle.
+"""The continuous refinement: every embedded joint solved at once, template shape against mesh.
 
-After the search and the refinement of the reduced joints, the joints of the embedded
-chains (reduced and inner ones) are solved together by alternating, as-rigid-as-possible
-fashion:
+The discrete search puts the reduced joints on sphere centres (sparse where the body is
+thick) and the inner joints of each chain follow the template chain mapped onto it. Then
+all the joints of the embedded chains are solved together, as-rigid-as-possible fashion,
+in a few rounds of one small linear least-squares problem each (joints x joints, and the
+scale), with these terms:
 
-* shape: every template bone, scaled and turned like its chain (the least rotation taking
-  the template chord onto the embedded chord), should be the bone in the mesh;
-* data: every joint should be at the middle of the mesh's cross-section across its bone
-  (:func:`rigedit.embedding.refine.centre_joints`), with a weight that falls with the
-  part's thickness: the middle of a limb is where its joints are, while the middle of a
-  trunk says little (a quadruped's spine runs along its back, not through its belly), so
-  there the template's shape relative to the limbs decides.
+* shape: every template bone, scaled, should be the bone in the mesh. A bone turns from
+  the template's direction towards its present one by how slender its part is (a limb: the
+  mesh shows which way it points; a spine in a trunk: it does not, and the frames are
+  shared, so the template's direction stands). A chain whose embedded ends are much closer
+  or further apart than the template's (short cartoon arms) takes that proportion.
+* data: every joint to the middle of the mesh's cross-section across its bone
+  (:func:`rigedit.embedding.centre.centre_joints`), weighted by how thin the part is: the
+  middle of a limb is where its joints are, the middle of a trunk says little (a quadruped's
+  spine runs along its back, not through its belly).
+* feet on the ground at the template's height above its ground; left and right joints
+  mirror images across the mesh's middle plane, middle joints on it; the scale held to the
+  one the heights and areas gave; a joint that left the mesh pulled back to the medial
+  spheres, and finally stepped back inside.
 
-Feet stand on the ground (see ``FEET``). Each round is one small linear least-squares solve (joints x joints); a few rounds settle.
+The weights are set by reasoning (see each constant), not learned.
 """
 from __future__ import annotations
 
