@@ -7,10 +7,9 @@ from __future__ import annotations
 
 import sys
 import warnings
-from pathlib import Path
 
 import numpy as np
-from PyQt5 import QtCore, QtGui, QtWidgets
+from PyQt5 import QtCore, QtWidgets
 from pyvistaqt import QtInteractor
 
 from ..document import Document
@@ -29,6 +28,7 @@ from .rebind import RestRebind
 from .weight_brush import install_weight_brush
 from .proxy_view import ProxyView
 from .weight_tools import install_weight_tools
+from .window_image import window_image
 
 __all__ = ["MainWindow", "default_rig"]
 
@@ -541,27 +541,7 @@ class MainWindow(MenusMixin, JobsMixin, QtWidgets.QMainWindow):
         -------
         QImage
         """
-        self.plotter.render()
-        QtWidgets.QApplication.processEvents()
-        self.plotter.render()
-        image = self.grab().toImage()
-        # The GL view is a native window that grab() may not capture: paint its own image in.
-        view = self.plotter.screenshot(return_img=True)
-        h, w = view.shape[:2]
-        view = np.ascontiguousarray(view[:, :, :3])
-        qimg = QtGui.QImage(view.data, w, h, 3 * w, QtGui.QImage.Format_RGB888)
-        top_left = self.plotter.mapTo(self, QtCore.QPoint(0, 0))
-        ratio = self.devicePixelRatioF()
-        painter = QtGui.QPainter(image)
-        painter.drawImage(QtCore.QRectF(top_left.x() * ratio, top_left.y() * ratio,
-                                        self.plotter.width() * ratio,
-                                        self.plotter.height() * ratio), qimg)
-        painter.end()
-        if path is not None:
-            Path(path).parent.mkdir(parents=True, exist_ok=True)
-            if not image.save(str(path)):
-                raise OSError(f"{path}: cannot write the screenshot")
-        return image
+        return window_image(self, self.plotter, path)
 
     def closeEvent(self, event):
         if self._closed:  # closed before (tests close twice): nothing left to ask or free
