@@ -7,7 +7,7 @@ import pytest
 
 from rigedit.render.ray import closest_on_line, pick_sphere, sphere_entries
 
-pv = pytest.importorskip("pyvista")
+import pyvista as pv  # noqa: E402
 
 SIZE = (400, 300)
 
