@@ -133,17 +133,17 @@ def test_every_template_joint_is_returned_with_stage_times(own_humanoid, humanoi
 def test_bundled_humanoid_on_its_own_mesh(own_humanoid, humanoid):
     truth = humanoid.skeleton.bind_matrices[:, :3, 3]
     cd = cd_j2j(own_humanoid.positions, truth, _diagonal(humanoid.vertices))
-    assert cd < 0.25  # measured 0.14%
+    assert cd < 0.25  # measured 0.17%
 
 
 def test_bundled_quadruped_on_its_own_mesh(quadruped):
     emb = _embed((quadruped.vertices, quadruped.faces), quadruped)
     truth = quadruped.skeleton.bind_matrices[:, :3, 3]
-    assert cd_j2j(emb.positions, truth, _diagonal(quadruped.vertices)) < 1.2  # measured 0.81%
+    assert cd_j2j(emb.positions, truth, _diagonal(quadruped.vertices)) < 1.2  # measured 0.77%
 
 
 def test_without_the_template_mesh_scale_and_ground_are_estimated(humanoid, quadruped):
-    for rig, limit in ((humanoid, 0.2), (quadruped, 2.4)):  # measured 0.12% and 1.56%
+    for rig, limit in ((humanoid, 0.2), (quadruped, 2.5)):  # measured 0.12% and 1.66%
         emb = _embed((rig.vertices, rig.faces), rig, use_mesh=False)
         truth = rig.skeleton.bind_matrices[:, :3, 3]
         assert cd_j2j(emb.positions, truth, _diagonal(rig.vertices)) < limit, rig.name
@@ -151,19 +151,19 @@ def test_without_the_template_mesh_scale_and_ground_are_estimated(humanoid, quad
 
 POSES = {
     # (rig, name): (angles, limit in %, measured)
-    ("humanoid", "A-pose"): ({"LeftArm": [0, 0, -45], "RightArm": [0, 0, 45]}, 3.0),  # 1.97
+    ("humanoid", "A-pose"): ({"LeftArm": [0, 0, -45], "RightArm": [0, 0, 45]}, 1.4),  # 0.92
     ("humanoid", "legs apart"): ({"LeftUpLeg": [0, 0, 15], "RightUpLeg": [0, 0, -15]},
-                                 0.9),  # 0.58
+                                 0.8),  # 0.52
     ("humanoid", "crouch"): ({"LeftUpLeg": [-30, 0, 0], "RightUpLeg": [-30, 0, 0],
                               "LeftLeg": [50, 0, 0], "RightLeg": [50, 0, 0],
                               "LeftFoot": [-20, 0, 0], "RightFoot": [-20, 0, 0],
-                              "Spine": [10, 0, 0]}, 2.9),  # 1.89
-    ("quadruped", "head down"): ({"neck_1": [25, 0, 0]}, 3.5),  # 2.36
+                              "Spine": [10, 0, 0]}, 2.5),  # 1.66
+    ("quadruped", "head down"): ({"neck_1": [25, 0, 0]}, 3.4),  # 2.25
     ("quadruped", "crouch"): ({"hind_thigh_L": [-15, 0, 0], "hind_thigh_R": [-15, 0, 0],
                                "hind_shin_L": [20, 0, 0], "hind_shin_R": [20, 0, 0],
                                "fore_upper_L": [15, 0, 0], "fore_upper_R": [15, 0, 0],
                                "fore_lower_L": [-20, 0, 0], "fore_lower_R": [-20, 0, 0]},
-                              1.5),  # 0.98
+                              1.5),  # 1.00
 }
 
 
@@ -207,8 +207,8 @@ def _khronos(name):
     return np.array(rig.skin(rest)), rig.faces, rig.joint_matrices(rest)[:, :3, 3], rig
 
 
-@pytest.mark.parametrize("name,limit", [("CesiumMan.glb", 4.0),   # measured 2.93% (target 4%)
-                                        ("RiggedFigure.glb", 4.0)])  # measured 3.00%
+@pytest.mark.parametrize("name,limit", [("CesiumMan.glb", 4.0),   # measured 2.90% (target 4%)
+                                        ("RiggedFigure.glb", 4.0)])  # measured 3.03%
 def test_khronos_humanoids_with_the_humanoid_template(name, limit, humanoid):
     vertices, faces, joints, rig = _khronos(name)
     table = KHRONOS[name]
@@ -225,11 +225,11 @@ def test_a_subdivided_mesh_gives_the_same_skeleton(humanoid):
     assert len(fine_f) == 4 * len(faces)
     fine = _embed((fine_v, fine_f), humanoid)
     # the same surface, four times the triangles: the joints hardly move
-    assert cd_j2j(fine.positions, coarse.positions, _diagonal(vertices)) < 0.5  # measured 0.24%
+    assert cd_j2j(fine.positions, coarse.positions, _diagonal(vertices)) < 0.6  # measured 0.40%
     table = KHRONOS["CesiumMan.glb"]
     pred = np.array([fine.positions[humanoid.skeleton.index[k]] for k in table])
     truth = np.array([joints[rig.skeleton.index[v]] for v in table.values()])
-    assert cd_j2j(pred, truth, _diagonal(vertices)) < 4.0  # measured 2.97% (target 4%)
+    assert cd_j2j(pred, truth, _diagonal(vertices)) < 4.0  # measured 2.65% (target 4%)
 
 
 def test_scale_and_translation_carry_through(own_humanoid, humanoid):
@@ -256,7 +256,7 @@ def test_small_holes_do_not_matter(humanoid):
     assert (~keep).sum() > 500
     emb = _embed((v, f[keep]), humanoid)
     truth = humanoid.skeleton.bind_matrices[:, :3, 3]
-    assert cd_j2j(emb.positions, truth, _diagonal(v)) < 0.25  # measured 0.16%
+    assert cd_j2j(emb.positions, truth, _diagonal(v)) < 0.35  # measured 0.23%
 
 
 def test_the_package_imports_no_gui_modules():
