@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import pyvista as pv
 
 from rigedit.render.ray import closest_on_line, pick_sphere, sphere_entries
-
-import pyvista as pv  # noqa: E402
 
 SIZE = (400, 300)
 
