@@ -90,5 +90,5 @@ def add_floor(plotter, lo, hi, axis, up, cells=40, style="plane"):
         # a little above the plane (2 cm over a 20 m floor), so the depth test never hides
         # the opaque lines in it
         grid.points += np.asarray(up, float) * (1e-3 * size)
-    return plotter.add_mesh(grid, color=lines, lighting=False, name="rig-grid",
+    return plotter.add_mesh(grid, color=lines, lighting=style == "lines", name="rig-grid",
                             reset_camera=False, pickable=False)

@@ -411,7 +411,10 @@ def _grid_floor(plotter, behind="#c3c9d0"):
     alpha = 0.7  # a little stronger than in the editor: the recorder has no floor plane
     prop = actor.GetProperty()
     prop.SetColor(*(alpha * np.array(pv.Color(GRID_COLOR).float_rgb) + (1 - alpha) * bg))
-    prop.LightingOff()
+    prop.LightingOn()   # as before: ambient only, so the pixels stay the same
+    prop.SetAmbient(1.0)
+    prop.SetDiffuse(0.0)
+    prop.SetSpecular(0.0)
 
 
 def _horizontal(offset, up):
