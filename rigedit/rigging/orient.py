@@ -23,35 +23,38 @@ else guessed, with how sure the guess is:
    near the hind legs, so its legs (the lowest slice) stand behind the middle of its length.
    Sure when the offset is at least :data:`SURE_FORWARD` of the length scale.
 
-When the mirror plane lies within :data:`SNAP_DEGREES` of a plane of the file's axes (files
-are almost always saved axis-aligned), it is snapped to it and the vertical is the in-plane
-file axis nearest the estimate; otherwise the vertical is turned (up to
-:data:`GROUND_DEGREES`) to level the ground, the support line most of the surface touches.
-A horizontal template's guess off the file's axes is never "sure": a long neck tilts the
-principal axes by tens of degrees (36 on the bundled elk). Measured on the bundled meshes,
-cow, homer, CesiumMan and RiggedFigure: all 24 axis-aligned turns of each recovered and
-sure; random turns of the bipeds recovered within 5 degrees.
+A long body (a quadruped template) is stood on its feet first: all round the mirror plane,
+the direction it stands on is the support line that its feet touch: contacts far apart
+(fore and hind hooves), under the centre of volume, each group of them on both sides of the
+mirror plane (left and right feet, not a tail or a chin on the middle), the most touched of
+those lines by a clear lead. That direction is down, with no sign to guess; without one
+the principal axes and the cues above decide (a long neck tilts the principal axes by tens
+of degrees: 36 on the elk, so that guess is only "sure" along the file's axes and on level
+ground there).
+
+A mirror plane or a vertical within :data:`SNAP_DEGREES` of the file's axes is snapped to
+them (files are almost always saved axis-aligned). Measured on the bundled meshes, cow,
+homer, CesiumMan and RiggedFigure: all 24 axis-aligned turns of each recovered and sure; 80
+random turns of each: all recovered within 5.5 degrees and sure, but one of the elk's (no
+ground found: "not sure", and wrong).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize
-from scipy.spatial import ConvexHull, cKDTree
+
+from .ground import angle, find_ground, support_up, tangents, unit
+from .mirror import surface_samples, symmetry_plane, volume_centroid
 
 __all__ = ["Orientation", "orient", "check_axes", "parse_axis", "axis_name", "SNAP_DEGREES"]
 
-SAMPLES = 4000
-SNAP_DEGREES = 15.0
+SNAP_DEGREES = 5.0
 SURE_ELONGATION = 1.25
 SURE_MASS = 0.02
 SURE_SPREAD = 0.05
 END_SLICE = 0.03
-GROUND_DEGREES = 20.0
 SURE_GROUND_TURN = 10.0
-GROUND_TOUCH = 0.005
-GROUND_SPAN = 0.2
 SURE_FORWARD = 0.01
 SURE_SYMMETRY = 0.03   # mean mirror mismatch, as a fraction of the size, for "symmetric"
 
@@ -119,101 +122,6 @@ class Orientation:
         return f"up {axis_name(self.up)}, forward {axis_name(self.forward)} ({how})"
 
 
-def _unit(v):
-    return v / np.linalg.norm(v)
-
-
-def surface_samples(vertices, faces, n=SAMPLES, seed=0):
-    """(n, 3) points spread uniformly over the surface (area-weighted, deterministic)."""
-    tri = vertices[faces]
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    rng = np.random.default_rng(seed)
-    pick = rng.choice(len(faces), size=n, p=area / area.sum())
-    r1, r2 = rng.random(n), rng.random(n)
-    s = np.sqrt(r1)
-    a, b, c = 1 - s, s * (1 - r2), s * r2
-    t = tri[pick]
-    return a[:, None] * t[:, 0] + b[:, None] * t[:, 1] + c[:, None] * t[:, 2]
-
-
-def volume_centroid(vertices, faces):
-    """Centre of the enclosed volume (signed tetrahedra from the origin); the mean vertex
-    when the mesh encloses next to nothing (open or inconsistently oriented)."""
-    tri = vertices[faces] - vertices.mean(axis=0)
-    vol = np.einsum("fi,fi->f", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])) / 6.0
-    total = vol.sum()
-    extent = np.ptp(vertices, axis=0)
-    if abs(total) < 1e-3 * np.prod(np.maximum(extent, 1e-12)):
-        return vertices.mean(axis=0)
-    return vertices.mean(axis=0) + (vol[:, None] * tri.sum(axis=1) / 4.0).sum(axis=0) / total
-
-
-def _fibonacci(n):
-    """(n, 3) directions spread over the upper half sphere (a direction and its negative are
-    the same mirror)."""
-    i = np.arange(n) + 0.5
-    z = i / n
-    phi = np.pi * (1 + 5 ** 0.5) * i
-    r = np.sqrt(1 - z * z)
-    return np.c_[r * np.cos(phi), r * np.sin(phi), z]
-
-
-def _mirror_cost(points, tree, normal, offset, centre):
-    n = _unit(normal)
-    d = (points - centre) @ n - offset
-    dist, _ = tree.query(points - 2 * d[:, None] * n, k=1)
-    return float(dist.mean())
-
-
-def _tangents(c):
-    e1 = _unit(np.cross(c, [1.0, 0, 0] if abs(c[0]) < 0.9 else [0, 1.0, 0]))
-    return e1, np.cross(c, e1)
-
-
-def _symmetry_plane(points, size, fixed=None):
-    """The best mirror plane of ``points`` (see the module notes).
-
-    Parameters
-    ----------
-    points : (N, 3) float64
-    size : float
-    fixed : (3,) float64, optional
-        A direction given by the user, which lies in the plane.
-
-    Returns
-    -------
-    normal : (3,) float64
-    mismatch : float
-        Mean distance of a reflected point to the nearest point, as a fraction of ``size``.
-    """
-    centre = points.mean(axis=0)
-    tree = cKDTree(points)
-    sub = points[:: max(1, len(points) // 1000)]
-    if fixed is None:
-        _, _, vt = np.linalg.svd(points - centre, full_matrices=False)
-        cands = np.vstack([_fibonacci(240), vt])
-    else:
-        e1, e2 = _tangents(fixed)
-        th = np.linspace(0, np.pi, 90, endpoint=False)
-        cands = np.outer(np.cos(th), e1) + np.outer(np.sin(th), e2)
-    coarse = points[:: max(1, len(points) // 300)]   # screening: 300 points tell planes apart
-    scores = [_mirror_cost(coarse, tree, c, 0.0, centre) for c in cands]
-    best = None
-    for c in cands[np.argsort(scores)[:2]]:
-        e1, e2 = _tangents(c) if fixed is None else (_unit(np.cross(fixed, c)), np.zeros(3))
-
-        def f(x, c=c, e1=e1, e2=e2):
-            return _mirror_cost(sub, tree, c + x[0] * e1 + x[1] * e2, x[2] * size, centre)
-        r = minimize(f, np.zeros(3), method="Nelder-Mead",
-                     options={"xatol": 1e-4, "fatol": 1e-7 * size, "maxiter": 300,
-                              "initial_simplex": np.vstack([np.zeros(3),
-                                                            np.diag([0.05, 0.05, 0.01])])})
-        if best is None or r.fun < best[0]:
-            best = (r.fun, _unit(c + r.x[0] * e1 + r.x[1] * e2), r.x[2] * size)
-    _, normal, offset = best
-    return normal, _mirror_cost(points, tree, normal, offset, centre) / size
-
-
 def _as_vector(v, what):
     if v is None:
         return None
@@ -222,7 +130,7 @@ def _as_vector(v, what):
     v = np.asarray(v, dtype=np.float64).reshape(3)
     if not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0:
         raise ValueError(f"expected a direction for {what}, got {v}")
-    return _unit(v)
+    return unit(v)
 
 
 def check_axes(up, forward):
@@ -238,11 +146,6 @@ def check_axes(up, forward):
         raise ValueError(f"expected --up and --forward at right angles, got up "
                          f"{axis_name(up)} and forward {axis_name(forward)}")
     return up, forward
-
-
-def _angle(a, b):
-    """Degrees between unit vectors."""
-    return float(np.degrees(np.arccos(np.clip(np.dot(a, b), -1.0, 1.0))))
 
 
 def _nearest_axis(v):
@@ -284,54 +187,6 @@ def _forward_cue(points, up, fwd, upright):
         return 0.0
     middle = 0.5 * (along.min() + along.max())
     return float((middle - legs.mean()) / max(np.ptp(along), 1e-12))
-
-
-def _support_up(points, normal, up, size, level=None):
-    """``up`` turned in the mirror plane so that the ground is level. The ground is the line
-    of support (in the mirror plane, within :data:`GROUND_DEGREES` of below) that most of the
-    surface touches, within :data:`GROUND_TOUCH` of the size: the soles, the hooves; a line
-    grazing a heel's curve or running from a hoof to the chin touches only points.
-
-    With ``level`` (the centre of volume, (3,)), return instead whether ``up`` itself is
-    level ground: the most touched line lies within a degree of it, its contacts lie apart
-    (at least :data:`GROUND_SPAN` of the size: heel and toe, fore and hind hooves; not one
-    point contact among ties), hold the body up (the centre of volume lies between them,
-    seen from above), and are feet: each group of contacts (split where they lie more than
-    :data:`GROUND_SPAN` / 4 apart) touches on both sides of the mirror plane, as left and
-    right feet do, not at a chin or a tail on the middle."""
-    e1, e2 = _tangents(normal)
-    flat = np.c_[points @ e1, points @ e2]
-    down = -np.array([up @ e1, up @ e2])
-    base = np.arctan2(down[1], down[0])
-    best = None
-    for span, step in ((np.radians(GROUND_DEGREES), np.radians(1.0)),
-                       (np.radians(1.0), np.radians(0.1))):
-        centre = base if best is None else best
-        ang = centre + np.arange(-span, span + step / 2, step)
-        d = np.c_[np.cos(ang), np.sin(ang)]
-        proj = d @ flat.T                                   # (A, N)
-        touch = (proj > proj.max(axis=1, keepdims=True) - GROUND_TOUCH * size).sum(axis=1)
-        # ties go to the angle nearest the estimate
-        pick = np.lexsort((np.abs(ang - centre), -touch))[0]
-        best = ang[pick]
-    found = _unit(-(np.cos(best) * e1 + np.sin(best) * e2))
-    if level is not None:
-        d = np.array([np.cos(best), np.sin(best)])
-        along = np.array([-d[1], d[0]])
-        proj = flat @ d
-        touching = proj > proj.max() - GROUND_TOUCH * size
-        contact = flat[touching] @ along
-        c = np.array([level @ e1, level @ e2]) @ along
-        if not (_angle(found, up) <= 1.0 and np.ptp(contact) >= GROUND_SPAN * size
-                and contact.min() < c < contact.max()):
-            return False
-        side = points[touching] @ normal - np.median(points @ normal)
-        order = np.argsort(contact)
-        groups = np.split(order, np.flatnonzero(np.diff(contact[order]) >
-                                                GROUND_SPAN / 4 * size) + 1)
-        return all((side[g] > GROUND_TOUCH * size).any() and (side[g] < -GROUND_TOUCH * size).any()
-                   for g in groups)
-    return found
 
 
 def _up_score(points, vertices, faces, up):
@@ -378,7 +233,7 @@ def orient(vertices, faces, upright=True, up=None, forward=None):
         return Orientation(up, forward, guessed=False, sure=True)
     points = surface_samples(vertices, faces)
     size = float(np.ptp(points, axis=0).max())
-    normal, mismatch = _symmetry_plane(points, size, up if up is not None else forward)
+    normal, mismatch = symmetry_plane(points, size, up if up is not None else forward)
     notes = {"symmetry": mismatch}
     sure = mismatch <= SURE_SYMMETRY
     aligned = _nearest_axis(normal)
@@ -386,47 +241,58 @@ def orient(vertices, faces, upright=True, up=None, forward=None):
         normal = aligned
     if up is None:
         if forward is not None:
-            vertical = _unit(np.cross(forward, normal))
+            vertical = unit(np.cross(forward, normal))
         else:
-            e1, e2 = _tangents(normal)
+            e1, e2 = tangents(normal)
             flat = np.c_[points @ e1, points @ e2]
             _, vecs = np.linalg.eigh(np.cov(flat.T))
             major, minor = (vecs[0, 1] * e1 + vecs[1, 1] * e2), (vecs[0, 0] * e1 + vecs[1, 0] * e2)
             ext = [np.subtract(*np.percentile(points @ a, [99.5, 0.5])) for a in (major, minor)]
             notes["elongation"] = float(ext[0] / max(ext[1], 1e-12))
             sure &= notes["elongation"] >= SURE_ELONGATION
-            vertical = _unit(major if upright else minor)
+            vertical = unit(major if upright else minor)
         snapped = False
-        if aligned is not None:
+        ground = None if upright else find_ground(points, normal, size,
+                                              volume_centroid(vertices, faces))
+        if ground is not None:
+            # a long body standing on its legs: the ground it stands on says which way is up
+            aligned_up = _nearest_axis(-ground)
+            vertical = aligned_up if aligned_up is not None and aligned is not None else -ground
+            snapped = True
+        elif aligned is not None:
             # a file saved along its axes: the vertical is an in-plane file axis when the
             # estimate is near one (a tall body), or, for a long body (a long neck tilts its
             # principal axes by tens of degrees), when the ground is level across that axis
             k = int(np.argmax(np.abs(vertical) * (np.abs(normal) < 0.5)))
             axis = np.eye(3)[k] * np.sign(vertical[k])
-            snapped = _angle(axis, vertical) <= SNAP_DEGREES if upright else any(
-                _support_up(points, normal, s * axis, size, level=volume_centroid(vertices, faces))
+            snapped = angle(axis, vertical) <= SNAP_DEGREES if upright else any(
+                support_up(points, normal, s * axis, size, level=volume_centroid(vertices, faces))
                 for s in (1.0, -1.0))
             if snapped:
                 vertical = axis
-        ups = [s * vertical if snapped else
-               _support_up(points, normal, s * vertical, size) for s in (1.0, -1.0)]
-        scores = [_up_score(points, vertices, faces, u) for u in ups]
-        k = int(scores[1][0] > scores[0][0])
-        up = ups[k]
-        notes["up"] = 0.5 * abs(scores[0][0] - scores[1][0])
-        notes["mass"], notes["feet"] = scores[k][1:]
-        notes["ground_turn"] = float(np.degrees(np.arccos(np.clip(abs(up @ vertical), -1, 1))))
-        sure &= notes["up"] >= 1.0 and notes["ground_turn"] <= SURE_GROUND_TURN
+        if ground is not None:
+            up = vertical                  # the side it stands on is down: no sign to guess
+            notes["stands"] = 1.0
+        else:
+            ups = [s * vertical if snapped else
+                   support_up(points, normal, s * vertical, size) for s in (1.0, -1.0)]
+            scores = [_up_score(points, vertices, faces, u) for u in ups]
+            k = int(scores[1][0] > scores[0][0])
+            up = ups[k]
+            notes["up"] = 0.5 * abs(scores[0][0] - scores[1][0])
+            notes["mass"], notes["feet"] = scores[k][1:]
+            notes["ground_turn"] = min(angle(up, vertical), angle(up, -vertical))
+            sure &= notes["up"] >= 1.0 and notes["ground_turn"] <= SURE_GROUND_TURN
         # a long body's principal axes tilt with its neck and head (36 degrees on the bundled
         # elk): off the file's axes, nothing pins its vertical down, so never claim it
         sure &= upright or snapped
     if forward is None:
-        fwd = _unit(np.cross(normal, up))
+        fwd = unit(np.cross(normal, up))
         cue = _forward_cue(points, up, fwd, upright)
         notes["forward"] = abs(cue)
         sure &= abs(cue) >= SURE_FORWARD
         forward = fwd if cue >= 0 else -fwd
-    up = _unit(up - (up @ forward) * forward) if abs(up @ forward) > 1e-9 else up
+    up = unit(up - (up @ forward) * forward) if abs(up @ forward) > 1e-9 else up
     snapped = _snap(up, forward)
     if snapped is not None:
         up, forward = snapped
