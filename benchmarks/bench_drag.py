@@ -100,6 +100,10 @@ def window_drag(rig, size, moves=120, proxy=True, window=None):
         w.proxy_view.attach()
     w.resize(*size)
     w.show()
+    ready = time.perf_counter() + 120   # the proxy is built in a worker thread
+    while w.proxy_view.building and time.perf_counter() < ready:
+        app.processEvents()
+        time.sleep(0.01)
     for _ in range(10):
         app.processEvents()
     w.view("side")

@@ -57,9 +57,16 @@ def test_subdivision_keeps_the_surface_and_interpolates_the_weights(quadruped, b
                                atol=1e-5)
 
 
-def test_proxy_is_smaller_and_follows_the_skinned_surface(big):
+def test_proxy_is_smaller_closed_and_follows_the_skinned_surface(big):
     proxy = build_proxy(big.binding, big.faces, target_faces=30_000)
     assert 15_000 <= proxy.num_faces <= 45_000 and proxy.full_faces == len(big.faces)
+    # no holes and no non-manifold edges (the full mesh is closed): clustering left thousands
+    mesh = pv.PolyData(proxy.vertices, np.hstack([np.full((proxy.num_faces, 1), 3),
+                                                  proxy.faces]).ravel())
+    assert mesh.extract_feature_edges(boundary_edges=True, non_manifold_edges=True,
+                                      feature_edges=False, manifold_edges=False).n_cells == 0
+    # its vertices are full-mesh vertices, kept in place
+    np.testing.assert_allclose(proxy.vertices, big.vertices[proxy.source], atol=1e-9)
     # each proxy vertex has its source vertex's influences
     np.testing.assert_array_equal(proxy.binding.indices, big.binding.indices[proxy.source])
     np.testing.assert_allclose(proxy.binding.weights, big.binding.weights[proxy.source])
@@ -109,7 +116,10 @@ def test_editor_shows_the_proxy_while_moving_and_says_so(qtbot, big):
     try:
         w.show()
         scene, label = w.scene, w.proxy_view.label
-        assert scene.proxy is not None and label.isVisible()
+        # built in a worker thread: the full mesh is drawn meanwhile, and the label says so
+        assert w.proxy_view.building and "preparing a proxy" in label.text()
+        qtbot.waitUntil(lambda: scene.proxy is not None, timeout=60_000)
+        assert label.isVisible()
         assert label.text().strip() == f"Full mesh: {len(big.faces):,} triangles"
         w.document.begin_drag()
         w.document.pose.set_euler(3, [20, 0, 0], degrees=True)

@@ -205,8 +205,9 @@ class RigScene:
                            self.mesh.GetPolys())
         self._normals.SetInputData(rest)
         self._normals.Update()
-        rest_normals = pv.wrap(self._normals.GetOutput()).point_data["Normals"]
+        rest_normals = np.array(pv.wrap(self._normals.GetOutput()).point_data["Normals"])
         binding.bind_normals(rest_normals)
+        self._rest_normals = rest_normals
         self._normals.SetInputData(self.mesh)
         if self._normals_binding is None:  # the mesh still shows the bind-space vertices
             self.mesh.point_data["Normals"][:] = rest_normals
@@ -351,8 +352,9 @@ class RigScene:
         instead of the mesh while :meth:`show_proxy` says so."""
         self.detach_proxy()
         tcoords = self.mesh.active_texture_coordinates if self._texture is not None else None
-        self.proxy_actor = ProxyActor(self.plotter, proxy, self.mesh_actor, self._texture,
-                                      tcoords)
+        self._bind_rest_normals()
+        self.proxy_actor = ProxyActor(self.plotter, proxy, self.mesh_actor,
+                                      self._rest_normals, self._texture, tcoords)
         self.proxy = proxy
 
     def detach_proxy(self):
