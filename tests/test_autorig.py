@@ -335,3 +335,24 @@ def test_bvh_template_lying_at_rest_is_stood_up_from_its_first_frame():
     # the mesh template keeps its rest, nothing else to try
     human = rigedit.load_rig("humanoid")
     assert [s for _, s in template_poses(human.skeleton, human, "humanoid")] == ["rest"]
+
+
+def test_leaf_tails_follow_the_rest_pose_when_the_template_binds_elsewhere():
+    """A glTF template may bind its mesh in another frame than its rest (CesiumMan binds Z
+    up): a leaf's tail, given at bind time, is carried to the rest pose before it is moved
+    with the embedded joint. Embedded exactly at the template's rest joints, every tail must
+    land where the rest pose carries it."""
+    rest_rot = Rotation.from_euler("x", [[0], [0], [0]], degrees=True).as_quat()
+    plain = Skeleton(["r", "a", "b"], [-1, 0, 1], [[0, 0, 0], [0, 1, 0], [0, 1, 0]],
+                     rest_rotation=rest_rot)
+    rest = plain.forward(plain.rest_local_matrices())
+    bind = rest.copy()
+    turn = np.eye(4)
+    turn[:3, :3] = Rotation.from_euler("x", 90, degrees=True).as_matrix()
+    bind = turn @ bind                                    # bound lying down, Z up
+    tails = np.full((3, 3), np.nan)
+    tails[2] = (turn @ np.r_[0.0, 2.5, 0.0, 1.0])[:3]      # 0.5 above b, in the bind frame
+    tmpl = Skeleton(["r", "a", "b"], [-1, 0, 1], [[0, 0, 0], [0, 1, 0], [0, 1, 0]],
+                    rest_rotation=rest_rot, bind_matrices=bind, tails=tails)
+    sk = build_skeleton(tmpl, rest[:, :3, 3])
+    np.testing.assert_allclose(sk.tails[2], [0.0, 2.5, 0.0], atol=1e-12)

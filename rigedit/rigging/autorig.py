@@ -151,10 +151,13 @@ def build_skeleton(template, positions):
     tails = np.full((n, 3), np.nan)
     has = np.all(np.isfinite(template.tails), axis=1)
     if has.any():
-        t_tails = template.tails[has]
-        # tails are given at bind time; carried relative to the bind head, turned and scaled
-        heads = template.bind_matrices[has, :3, 3]
-        tails[has] = positions[has] + scale * np.einsum("tij,tj->ti", turn[has], t_tails - heads)
+        # tails are given at bind time: carried to the rest pose by their joint, then taken
+        # relative to the rest head, turned and scaled
+        bind_local = np.einsum("tij,tj->ti", template.inverse_bind_matrices[has],
+                               np.c_[template.tails[has], np.ones(has.sum())])
+        t_tails = np.einsum("tij,tj->ti", rest[has], bind_local)[:, :3]
+        tails[has] = positions[has] + scale * np.einsum("tij,tj->ti", turn[has],
+                                                        t_tails - t_pos[has])
     return Skeleton(list(template.names), template.parents.copy(), local_t,
                     Rotation.from_matrix(local_r).as_quat(), tails=tails,
                     deform=template.deform.copy())
