@@ -356,3 +356,12 @@ def test_leaf_tails_follow_the_rest_pose_when_the_template_binds_elsewhere():
                     rest_rotation=rest_rot, bind_matrices=bind, tails=tails)
     sk = build_skeleton(tmpl, rest[:, :3, 3])
     np.testing.assert_allclose(sk.tails[2], [0.0, 2.5, 0.0], atol=1e-12)
+
+
+def test_array_input_is_checked():
+    with pytest.raises(ValueError, match=r"mesh: expected finite vertices of shape \(V, 3\)"):
+        rigedit.autorig((np.zeros((4, 2)), [[0, 1, 2]]))
+    with pytest.raises(ValueError, match="mesh: expected faces .* below 3"):
+        rigedit.autorig((np.eye(3), [[0, 1, 3]]))
+    with pytest.raises(RigFileError, match="mesh: expected a surface mesh, got no faces"):
+        rigedit.autorig((np.eye(3), np.zeros((0, 3), int)))

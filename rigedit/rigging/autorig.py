@@ -163,6 +163,24 @@ def build_skeleton(template, positions):
                     deform=template.deform.copy())
 
 
+def _arrays(mesh):
+    """(vertices (V, 3) float64, faces (F, 3) int64) from a pair, checked like a file."""
+    try:
+        vertices, faces = mesh
+        vertices = np.asarray(vertices, dtype=np.float64)
+        faces = np.asarray(faces)
+    except (TypeError, ValueError):
+        raise ValueError("mesh: expected a path or a (vertices, faces) pair") from None
+    if vertices.ndim != 2 or vertices.shape[1] != 3 or not np.all(np.isfinite(vertices)):
+        raise ValueError(f"mesh: expected finite vertices of shape (V, 3), got "
+                         f"{vertices.shape}")
+    if faces.size and (faces.ndim != 2 or faces.shape[1] != 3 or faces.dtype.kind not in "iu"
+                       or faces.min() < 0 or faces.max() >= len(vertices)):
+        raise ValueError(f"mesh: expected faces (F, 3) of vertex indices below "
+                         f"{len(vertices)}, got {faces.shape} {faces.dtype}")
+    return vertices, faces.reshape(-1, 3).astype(np.int64)
+
+
 def _placement(vertices, orientation):
     """(4, 4) input -> rig: turn into rigedit's frame, stand on y = 0, centre x and z."""
     m = np.eye(4)
@@ -180,7 +198,7 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     Parameters
     ----------
     mesh : str, Path or (vertices (V, 3), faces (F, 3))
-        A mesh file (OBJ, PLY, STL, OFF, VTK, VTP..., or a .glb's mesh) or arrays.
+        A mesh file (OBJ, PLY, STL, VTK, VTU, VTP, or a .glb/.gltf's mesh) or arrays.
     template : str, Path, Rig or Skeleton
         ``"humanoid"``, ``"quadruped"``, a skeleton file, rig folder, .glb or .bvh (its clips
         come along), or an object.
@@ -226,9 +244,7 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
         vertices, faces = read_mesh(mesh)
     else:
         source = "mesh"
-        vertices, faces = (np.asarray(a) for a in mesh)
-        vertices = vertices.astype(np.float64)
-        faces = faces.astype(np.int64)
+        vertices, faces = _arrays(mesh)
     checks = check_mesh(vertices, faces, source)
     seconds["load/check"] = time.perf_counter() - t0
 
