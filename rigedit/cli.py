@@ -253,9 +253,11 @@ def build_parser():
                    help="a bundled character's skeleton, or a skeleton .json, rig folder, "
                         ".glb or .bvh (its clips come along)")
     s.add_argument("--up", default=None, metavar="AXIS",
-                   help="the mesh's up axis (y, -z, ...; default: guessed and reported)")
+                   help="the mesh's up axis (y, z, ...; a negative one as --up=-z; default: "
+                        "guessed and reported)")
     s.add_argument("--forward", default=None, metavar="AXIS",
-                   help="the way the character faces (z, -x, ...; default: guessed)")
+                   help="the way the character faces (z, x, ...; a negative one as "
+                        "--forward=-x; default: guessed)")
     s.add_argument("--method", default="heat", help="skin weights: heat (default) or idw")
     s.add_argument("--no-clips", action="store_true", help="do not retarget the template's clips")
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
