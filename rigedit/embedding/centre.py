@@ -34,9 +34,10 @@ def centre_joints(field, points, directions, reach=1.5):
     out = np.array(points, dtype=np.float64)
     depth = field(out)
     for i in range(len(out)):
-        if depth[i] <= 0 or not np.all(np.isfinite(directions[i])):
+        length = np.linalg.norm(directions[i])
+        if depth[i] <= 0 or not np.isfinite(length) or length < 1e-12:
             continue
-        d = directions[i] / max(np.linalg.norm(directions[i]), 1e-300)
+        d = directions[i] / length
         e1 = np.cross(d, [1.0, 0, 0] if abs(d[0]) < 0.9 else [0, 1.0, 0])
         e1 /= np.linalg.norm(e1)
         e2 = np.cross(d, e1)

@@ -156,7 +156,13 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
             if out_.any():
                 target[out_] = medial[medial_tree.query(x[out_])[1]]
                 lam[out_] = W_INSIDE
-        x, scale = _solve(k, pb, cb, v, lam, target, scale0, rows, hold_scale)
+        try:
+            x_new, s_new = _solve(k, pb, cb, v, lam, target, scale0, rows, hold_scale)
+        except np.linalg.LinAlgError:
+            break
+        if not (np.all(np.isfinite(x_new)) and np.isfinite(s_new) and s_new > 0):
+            break  # keep the last good round rather than spread a degenerate one
+        x, scale = x_new, s_new
     if medial is not None:
         x = _step_inside(field, x, medial[medial_tree.query(x)[1]])
     out = positions.copy()

@@ -38,7 +38,9 @@ W_MIRROR = 0.5
 W_CARRY = 0.5
 #: Two limb ends that the template keeps far apart along the tree (the feet: the tree path
 #: through the hips is many times their distance) must be separated in the mesh too: their
-#: graph path must be at least this much longer than their distance. A blob fails here.
+#: graph path must be at least this much longer than their distance. A blob fails here
+#: (and so does a template whose hands hang by its hips against a mesh whose arms are out:
+#: the template must stand roughly as the mesh does).
 SEPARATE_RATIO = 1.4
 
 

@@ -20,8 +20,11 @@ __all__ = ["least_rotation", "place_chains", "place_carried"]
 
 def least_rotation(a, b):
     """The least rotation taking direction ``a`` (3,) onto direction ``b`` (3,)."""
-    a = np.asarray(a, float) / max(np.linalg.norm(a), 1e-300)
-    b = np.asarray(b, float) / max(np.linalg.norm(b), 1e-300)
+    la, lb = np.linalg.norm(a), np.linalg.norm(b)
+    if la < 1e-12 or lb < 1e-12 or not np.isfinite(la * lb):
+        return Rotation.identity()  # a zero-length bone has no direction to turn
+    a = np.asarray(a, float) / la
+    b = np.asarray(b, float) / lb
     axis = np.cross(a, b)
     s, c = np.linalg.norm(axis), float(np.dot(a, b))
     if s < 1e-12:

@@ -26,6 +26,8 @@ __all__ = ["Search", "discrete_embedding"]
 #: Children pushed per expansion (the cheapest by cost plus bound): the others are so much
 #: dearer that the search would never come back to them.
 BRANCH = 48
+#: Partial embeddings kept per depth by the beam search that takes over when A* runs out.
+BEAM = 64
 #: Radius, in cells, of the thinnest part an optional branch may be embedded in.
 RESOLVED = 2.0
 #: Expansions before the search gives up and keeps the best complete embedding seen.
@@ -44,16 +46,20 @@ class Search:
     expansions : int
     failed : int
         The reduced joint that could not be placed when ``vertex`` is None, else -1.
+    parts : (R,) float64
+        Each reduced joint's share of the tree cost (its bone and its own terms).
     """
 
     vertex: np.ndarray
     cost: float
     expansions: int
     failed: int = -1
+    parts: np.ndarray = None
 
 
 def _separated_pairs(template):
-    """Reduced leaf pairs whose tree path is at least 3 times their distance (the feet)."""
+    """Reduced leaf pairs whose tree path is at least 3 times their distance (the feet, or
+    hands hanging by the hips), as (a, b, tree path length)."""
     rest = template.rest[template.joints]
     parent = template.parent
     r = len(parent)
@@ -75,11 +81,11 @@ def _separated_pairs(template):
             ub = up(b)
             tree = min(ua[k] + ub[k] for k in ua if k in ub)
             if tree >= 3.0 * np.linalg.norm(rest[a] - rest[b]):
-                pairs.append((a, b))
+                pairs.append((a, b, tree))
     return pairs
 
 
-def discrete_embedding(graph, template, frame, scale, progress=None):
+def discrete_embedding(graph, template, frame, scale, progress=None, field=None):
     """Embed ``template`` (a ReducedTemplate) into ``graph`` (a MedialGraph).
 
     Parameters
@@ -91,6 +97,9 @@ def discrete_embedding(graph, template, frame, scale, progress=None):
         Mesh units per template unit.
     progress : callable(fraction), optional
         Called now and then with the fraction done (may raise to cancel).
+    field : DistanceField, optional
+        The mesh's distance field: two feet must then stand apart, the straight segment
+        between them leaving the mesh (a gap between the legs), which no blob has.
 
     Returns
     -------
@@ -128,39 +137,38 @@ def discrete_embedding(graph, template, frame, scale, progress=None):
     unit = 0.05 * template.size * scale
     sep = _separated_pairs(template)
     partner = {}
-    for a, b in sep:
-        partner.setdefault(max(a, b), []).append(min(a, b))
+    span = np.ptp(template.rest[~template.carried, 1])
+    foot = (rest[:, 1] - template.floor < FEET * span) & np.array(
+        [not np.any(parent == k) for k in range(r)])
+    gap_cache = {}
+
+    def gap(q):
+        """(N,) bool: the segment from vertex q to each vertex leaves the mesh."""
+        if q not in gap_cache:
+            gap_cache[q] = ~field.segments_inside(np.repeat(pts[q:q + 1], n, axis=0), pts)
+        return gap_cache[q]
+
+    for a, b, tree in sep:
+        test = gap if field is not None and foot[a] and foot[b] else None
+        partner.setdefault(max(a, b), []).append((min(a, b), test))
 
     later_mirror = np.full(r, -1)
     for k in range(r):
         if template.mirror[k] > k:
             later_mirror[k] = template.mirror[k]
-    heap = []
-    f0 = down[0]
-    for v in np.argsort(f0)[:BRANCH]:
-        if np.isfinite(f0[v]):
-            heap.append((float(f0[v]), float(unary[0][v]), (int(v),), ()))
-    heapq.heapify(heap)
-    expansions = 0
     stuck = np.zeros(r, dtype=np.int64)
-    while heap:
-        # pending: (joint, bound) pairs already added to f for mirror partners to come
-        f, g, assign, pending = heapq.heappop(heap)
+
+    def expand(state):
+        """The children of a partial embedding (f, g, assign, pending), where pending
+        holds (joint, bound) pairs already added to f for mirror partners to come."""
+        f, g, assign, pending = state
         k = len(assign)
-        if k == r:
-            return Search(np.asarray(assign), g, expansions)
-        expansions += 1
-        if expansions % 200 == 0 and progress is not None:
-            progress(min(1.0, expansions / MAX_EXPANSIONS))
-        if expansions > MAX_EXPANSIONS:
-            break
         a = assign[parent[k]]
         own = sum(extra for j, extra in pending if j == k)
         pending = tuple(p for p in pending if p[0] != k)
         h_rest = f - g - (best[k][a] if a >= 0 else 0.0) - own
         if a < 0:  # the parent is carried, so is this joint
-            heapq.heappush(heap, (f - own, g, assign + (-1,), pending))
-            continue
+            return [(f - own, g, assign + (-1,), pending)]
         used = np.array([v for v in assign if v >= 0])
         gk = pair[k][a] + unary[k] + _coupling(k, assign, pts, dist, template, partner, frame,
                                                unit)
@@ -170,12 +178,12 @@ def discrete_embedding(graph, template, frame, scale, progress=None):
         order = np.argsort(fk)[:BRANCH]
         order = order[np.isfinite(fk[order])]
         m = later_mirror[k]
+        extra = np.zeros(len(order))
         if len(order) and m >= 0 and assign[parent[m]] >= 0:
             # Tighten the bound with the mirror partner still to come: its best place given
             # this joint's, mirror and separation terms included (exact for a leaf partner).
             am = assign[parent[m]]
             base = pair[m][am] + down[m]
-            extra = np.empty(len(order))
             for i, v in enumerate(order):
                 trial = assign + (int(v),) + (-2,) * (m - k - 1)
                 cm = base + _coupling(m, trial, pts, dist, template, partner, frame, unit)
@@ -187,15 +195,53 @@ def discrete_embedding(graph, template, frame, scale, progress=None):
                 extra[i] = top - best[m][am]
             keep = np.isfinite(extra)
             order, extra = order[keep], extra[keep]
-        else:
-            extra = np.zeros(len(order))
         if len(order) == 0:
             stuck[k] += 1
-        for v, e in zip(order, extra):
-            heapq.heappush(heap, (float(fk[v] + e), float(g + gk[v]), assign + (int(v),),
-                                  pending + ((m, float(e)),) if e else pending))
+        out = [(float(fk[v] + e), float(g + gk[v]), assign + (int(v),),
+                pending + ((m, float(e)),) if e else pending) for v, e in zip(order, extra)]
         if template.optional[k]:
-            heapq.heappush(heap, (g + W_CARRY + h_rest, g + W_CARRY, assign + (-1,), pending))
+            out.append((g + W_CARRY + h_rest, g + W_CARRY, assign + (-1,), pending))
+        return out
+
+    def _done(state, expansions):
+        assign = np.asarray(state[2])
+        parts = np.zeros(r)
+        for k in range(r):
+            if assign[k] >= 0:
+                parts[k] = unary[k][assign[k]] + (pair[k][assign[parent[k]], assign[k]]
+                                                  if k else 0.0)
+            elif template.optional[k] and (k == 0 or assign[parent[k]] >= 0):
+                parts[k] = W_CARRY
+        return Search(assign, state[1], expansions, parts=parts)
+
+    f0 = down[0]
+    start = [(float(f0[v]), float(unary[0][v]), (int(v),), ())
+             for v in np.argsort(f0)[:BRANCH] if np.isfinite(f0[v])]
+    heap = list(start)
+    heapq.heapify(heap)
+    expansions = 0
+    while heap:
+        state = heapq.heappop(heap)
+        if len(state[2]) == r:
+            return _done(state, expansions)
+        expansions += 1
+        if expansions % 200 == 0 and progress is not None:
+            progress(min(1.0, expansions / MAX_EXPANSIONS))
+        if expansions > MAX_EXPANSIONS:
+            break
+        for child in expand(state):
+            heapq.heappush(heap, child)
+    if heap:
+        # The bound was too loose for A* to finish (a template posed far from the mesh:
+        # arms down against arms out); a beam search keeps going with the same costs.
+        states = start
+        for _ in range(1, r):
+            states = heapq.nsmallest(BEAM, (c for st in states for c in expand(st)))
+            if not states:
+                break
+        if states:
+            done = min(states, key=lambda st: st[1])
+            return _done(done, expansions)
     return Search(None, np.inf, expansions, failed=int(np.argmax(stuck)) if stuck.any()
                   else _first_unplaceable(best, template))
 
@@ -207,8 +253,11 @@ def _coupling(k, assign, pts, dist, template, partner, frame, unit):
     m = template.mirror[k]
     if 0 <= m < len(assign) and assign[m] >= 0:
         out += mirror_cost(pts, pts[assign[m]], frame["plane_x"], unit)
-    for q in partner.get(k, []):
+    for q, gap in partner.get(k, []):
         if q < len(assign) and assign[q] >= 0:
+            if gap is not None:  # two feet: the straight way between them leaves the mesh
+                out[~gap(assign[q])] = np.inf
+                continue
             apart = np.linalg.norm(pts - pts[assign[q]], axis=1)
             out[dist[assign[q]] < SEPARATE_RATIO * apart] = np.inf
     return out
