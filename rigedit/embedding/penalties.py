@@ -17,24 +17,30 @@ import numpy as np
 __all__ = ["bone_costs", "joint_costs", "mirror_cost", "W_CARRY", "SEPARATE_RATIO"]
 
 #: Bone length, as twice the (log ratio)^2 of the chord to the template chord (times the
-#: scale): 3 makes a bone 25% too long or short cost ~0.3: proportions vary between
-#: characters (short legs, long arms) by about that much.
+#: scale): a bone 25% too long or short costs 0.1, half or twice as long ~1. Weak on
+#: purpose: proportions vary between characters (a cow's long body against the elk's, a
+#: cartoon's short legs), and a stronger length term made the search fold a cow's body to
+#: the elk's length, hind legs in the front legs.
 W_LENGTH = 1.0
 #: Allowed excess of a path's detour (log of path over chord) over the template chain's.
 DETOUR = 0.15
-#: Bone direction, times (1 - cos) of the angle to the template chord: 0.6 for 45 degrees
-#: (an A-pose arm against a T-pose template, still acceptable), 2 for a right angle, 4 for
-#: a bone pointing backwards (a leg going up).
+#: Bone direction, times (1 - cos) of the angle to the template chord: 0.9 for 45 degrees
+#: (an A-pose arm against a T-pose template, still acceptable), 3 for a right angle, 6 for
+#: a bone pointing backwards (a leg going up). The frames are shared (+Y up, facing +Z),
+#: so direction is the strongest evidence of which part is which.
 W_DIRECTION = 3.0
-#: Joint height, as the squared difference of the joint's height and the template's, in
-#: quarters of the mesh height: feet low, head high; 0.16 for a tenth of the height off.
+#: Foot height, as the squared difference of a foot's height above the ground and the
+#: template's (scaled), in quarters of the mesh height: 0.16 for a tenth of the height off.
 W_HEIGHT = 1.0
+#: The same for the other joints: none. Characters differ in proportions (short legs, a
+#: big head) far more than feet differ in height; a height prior put homer's chest in his
+#: mouth.
 W_HEIGHT_OTHER = 0.0
 #: Symmetry, as the squared distance between a joint and its mirror partner's reflection in
 #: units of 5% of the template's size (scaled): a limb 5% off its mirror costs 0.5.
 W_MIRROR = 0.5
-#: Price of leaving an optional branch (antlers, a tail) unembedded: higher than a fair fit
-#: (a few tenths) and lower than a forced, contorted one.
+#: Price of leaving an optional branch (antlers, a tail) unembedded: about a fair fit's
+#: cost for one bone, so a branch is embedded only where the mesh clearly has it.
 W_CARRY = 0.5
 #: Two limb ends that the template keeps far apart along the tree (the feet: the tree path
 #: through the hips is many times their distance) must be separated in the mesh too: their
@@ -95,9 +101,8 @@ def joint_costs(points, template_y, template_floor, floor, height, scale, foot):
         The mesh's lowest point and height.
     scale : float
     foot : bool
-        The joint stands on the ground (an ankle, a hoof): full weight. Other joints get
-        ``W_HEIGHT_OTHER``: characters differ in proportions (short legs, a big head) far
-        more than feet differ in height above the ground.
+        The joint stands on the ground (an ankle, a hoof): ``W_HEIGHT``; other joints get
+        ``W_HEIGHT_OTHER``.
     """
     expected = scale * (template_y - template_floor)
     weight = W_HEIGHT if foot else W_HEIGHT_OTHER

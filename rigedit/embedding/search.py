@@ -4,12 +4,16 @@ Each reduced joint goes to a graph vertex (or, for an optional branch, is carrie
 cost is the sum of the bone and joint penalties (a tree: parent-child terms only) plus the
 mirror penalties between left and right. The tree part alone is minimised exactly by
 dynamic programming over the reduced tree; that minimum, for the joints not yet placed,
-is the search's lower bound, exact wherever the mirror terms vanish. Pinocchio's own
-bound is looser (it searches without the tree's exact cost-to-go); with this one the
-search places joints in order and rarely backs up, so it needs few expansions.
+is the search's lower bound, tightened with the exact best place of a mirror partner still
+to come. Pinocchio's own bound is looser (it searches without the tree's exact
+cost-to-go); with this one the search places joints in order and rarely backs up: 11 to 40
+expansions on the test meshes. Should it run out of expansions anyway (a template posed far
+from the mesh), a beam search with the same costs and bound finishes.
 
-Joints are placed parent before child; two joints never share a vertex, and limb ends the
-template keeps apart along its tree (the feet) must be apart along the graph too.
+Joints are placed parent before child; two joints never share a vertex; two feet must
+stand apart (the straight way between them leaves the mesh), and other limb ends the
+template keeps apart along its tree (hands hanging by the hips) must be apart along the
+graph too. No blob passes these.
 """
 from __future__ import annotations
 
@@ -30,7 +34,7 @@ BRANCH = 48
 BEAM = 64
 #: Radius, in cells, of the thinnest part an optional branch may be embedded in.
 RESOLVED = 2.0
-#: Expansions before the search gives up and keeps the best complete embedding seen.
+#: Expansions before A* hands over to the beam search.
 MAX_EXPANSIONS = 3000
 
 
