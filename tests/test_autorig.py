@@ -365,3 +365,17 @@ def test_array_input_is_checked():
         rigedit.autorig((np.eye(3), [[0, 1, 3]]))
     with pytest.raises(RigFileError, match="mesh: expected a surface mesh, got no faces"):
         rigedit.autorig((np.eye(3), np.zeros((0, 3), int)))
+
+
+def test_glb_mesh_keeps_its_texture_coordinates_and_materials(tmp_path):
+    cesium = DATA / "khronos-gltf" / "CesiumMan.glb"
+    if not cesium.is_file():
+        pytest.skip(f"{cesium} is absent (shared test data)")
+    src = rigedit.load_rig(cesium)
+    rig = rigedit.autorig(cesium, clips=False)
+    assert rig.autorig_report.orientation.describe() == "up +y, forward +z (guessed)"
+    assert len(rig.vertices) == len(src.vertices)         # seams kept, as the file has them
+    np.testing.assert_array_equal(rig.surface.uvs, src.surface.uvs)
+    assert rig.surface.textured_material() is not None and rig.surface.normals is None
+    back = rigedit.load_rig(rig.save(tmp_path / "cesium.glb"))
+    np.testing.assert_allclose(back.surface.uvs, src.surface.uvs, atol=1e-6)

@@ -241,9 +241,9 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     poses = template_poses(t_sk, t_rig, t_name)
     if isinstance(mesh, (str, Path)):
         source = str(mesh)
-        vertices, faces = read_mesh(mesh)
+        vertices, faces, surface = read_mesh(mesh, with_surface=True)
     else:
-        source = "mesh"
+        source, surface = "mesh", None
         vertices, faces = _arrays(mesh)
     checks = check_mesh(vertices, faces, source)
     seconds["load/check"] = time.perf_counter() - t0
@@ -287,7 +287,8 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     rig_v = vertices @ place[:3, :3].T + place[:3, 3]
     idx, w = compute_weights(rig_v, skeleton, weights, faces=faces, progress=band("weights"))
     name = Path(source).stem if source != "mesh" else "autorig"
-    rig = Rig(skeleton, rig_v, faces, idx, w, name=name, up="y", weights_method=weights)
+    rig = Rig(skeleton, rig_v, faces, idx, w, name=name, up="y", weights_method=weights,
+              surface=surface)
     rig.weights_computed = True
     seconds["weights"] = time.perf_counter() - t0
 

@@ -89,14 +89,24 @@ class MeshCheck:
                 f"parts: {parts}"]
 
 
-def read_mesh(path):
+def read_mesh(path, with_surface=False):
     """Vertices and faces of a mesh file to auto-rig: any format :func:`rigedit.io.mesh.load_mesh`
     reads, or a ``.glb``/``.gltf`` (its skinned mesh at the rest pose when it has a skin).
+
+    Parameters
+    ----------
+    path : str or Path
+    with_surface : bool
+        Also return the glTF's texture coordinates and materials (a
+        :class:`rigedit.surface.Surface` without normals: the file's are in its bind frame;
+        None for other formats), so an auto-rigged character keeps its look.
 
     Returns
     -------
     vertices : (V, 3) float64
     faces : (F, 3) int64
+    surface : Surface or None
+        Only with ``with_surface``.
 
     Raises
     ------
@@ -104,12 +114,17 @@ def read_mesh(path):
         Unreadable file, or no faces (a point cloud has no inside to embed a skeleton in).
     """
     path = Path(path)
+    surface = None
     if path.suffix.lower() in (".glb", ".gltf"):
+        from dataclasses import replace
+
         from ..io.gltf_read import load_gltf
 
         rig = load_gltf(path)
         faces = rig.faces
         vertices = rig.skin(rig.rest_pose()) if len(rig.vertices) else rig.vertices
+        if rig.surface is not None:
+            surface = replace(rig.surface, normals=None)
     else:
         from ..io.mesh import load_mesh
 
@@ -124,7 +139,8 @@ def read_mesh(path):
     if len(faces) == 0:
         raise RigFileError(path, "expected a surface mesh (triangles or polygons), got no "
                                  "faces: a point cloud has no inside to place a skeleton in")
-    return np.asarray(vertices, dtype=np.float64), np.asarray(faces, dtype=np.int64)
+    out = np.asarray(vertices, dtype=np.float64), np.asarray(faces, dtype=np.int64)
+    return (*out, surface) if with_surface else out
 
 
 def _edges(faces):
