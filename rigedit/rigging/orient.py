@@ -189,19 +189,54 @@ def _forward_cue(points, up, fwd, upright):
     return float((middle - legs.mean()) / max(np.ptp(along), 1e-12))
 
 
-def _up_score(points, vertices, faces, up):
+def _up_score(points, centre, up):
     """Evidence that ``up`` (not ``-up``) is up, in units of the sure margins, and the two
-    cues (see the module notes, step 3)."""
+    cues (see the module notes, step 3); ``centre`` is the centre of volume."""
     t = points @ up
     lo, hi = t.min(), t.max()
     h = max(hi - lo, 1e-12)
-    mass = (volume_centroid(vertices, faces) @ up - 0.5 * (lo + hi)) / h
+    mass = (centre @ up - 0.5 * (lo + hi)) / h
 
     def spread(sl):
         flat = sl - np.outer(sl @ up, up)
         return np.linalg.norm(np.ptp(flat, axis=0)) / h if len(sl) > 1 else 0.0
     feet = spread(points[t < lo + END_SLICE * h]) - spread(points[t > hi - END_SLICE * h])
     return mass / SURE_MASS + feet / SURE_SPREAD, float(mass), float(feet)
+
+
+def _up(points, centre, normal, size, vertical, aligned, upright, notes):
+    """Up (3,) from the vertical estimate in the mirror plane, and whether it is sure; the
+    margins go into ``notes`` (see the module notes, steps 2 and 3)."""
+    snapped = False
+    ground = None if upright else find_ground(points, normal, size, centre)
+    if ground is not None:
+        # a long body standing on its legs: the ground it stands on says which way is up,
+        # no sign to guess
+        notes["stands"] = 1.0
+        along = _nearest_axis(-ground)
+        return (along if along is not None and aligned is not None else -ground), True
+    if aligned is not None:
+        # a file saved along its axes: the vertical is an in-plane file axis when the
+        # estimate is near one (a tall body), or, for a long body (a long neck tilts its
+        # principal axes by tens of degrees), when the ground is level across that axis
+        k = int(np.argmax(np.abs(vertical) * (np.abs(normal) < 0.5)))
+        axis = np.eye(3)[k] * np.sign(vertical[k])
+        snapped = angle(axis, vertical) <= SNAP_DEGREES if upright else any(
+            support_up(points, normal, s * axis, size, level=centre) for s in (1.0, -1.0))
+        if snapped:
+            vertical = axis
+    ups = [s * vertical if snapped else support_up(points, normal, s * vertical, size)
+           for s in (1.0, -1.0)]
+    scores = [_up_score(points, centre, u) for u in ups]
+    k = int(scores[1][0] > scores[0][0])
+    up = ups[k]
+    notes["up"] = 0.5 * abs(scores[0][0] - scores[1][0])
+    notes["mass"], notes["feet"] = scores[k][1:]
+    notes["ground_turn"] = min(angle(up, vertical), angle(up, -vertical))
+    # off the file's axes nothing pins a long body's vertical down but a ground it stands on
+    sure = (notes["up"] >= 1.0 and notes["ground_turn"] <= SURE_GROUND_TURN
+            and (upright or snapped))
+    return up, sure
 
 
 def orient(vertices, faces, upright=True, up=None, forward=None):
@@ -236,6 +271,7 @@ def orient(vertices, faces, upright=True, up=None, forward=None):
     normal, mismatch = symmetry_plane(points, size, up if up is not None else forward)
     notes = {"symmetry": mismatch}
     sure = mismatch <= SURE_SYMMETRY
+    centre = volume_centroid(vertices, faces)
     aligned = _nearest_axis(normal)
     if aligned is not None:
         normal = aligned
@@ -251,41 +287,8 @@ def orient(vertices, faces, upright=True, up=None, forward=None):
             notes["elongation"] = float(ext[0] / max(ext[1], 1e-12))
             sure &= notes["elongation"] >= SURE_ELONGATION
             vertical = unit(major if upright else minor)
-        snapped = False
-        ground = None if upright else find_ground(points, normal, size,
-                                              volume_centroid(vertices, faces))
-        if ground is not None:
-            # a long body standing on its legs: the ground it stands on says which way is up
-            aligned_up = _nearest_axis(-ground)
-            vertical = aligned_up if aligned_up is not None and aligned is not None else -ground
-            snapped = True
-        elif aligned is not None:
-            # a file saved along its axes: the vertical is an in-plane file axis when the
-            # estimate is near one (a tall body), or, for a long body (a long neck tilts its
-            # principal axes by tens of degrees), when the ground is level across that axis
-            k = int(np.argmax(np.abs(vertical) * (np.abs(normal) < 0.5)))
-            axis = np.eye(3)[k] * np.sign(vertical[k])
-            snapped = angle(axis, vertical) <= SNAP_DEGREES if upright else any(
-                support_up(points, normal, s * axis, size, level=volume_centroid(vertices, faces))
-                for s in (1.0, -1.0))
-            if snapped:
-                vertical = axis
-        if ground is not None:
-            up = vertical                  # the side it stands on is down: no sign to guess
-            notes["stands"] = 1.0
-        else:
-            ups = [s * vertical if snapped else
-                   support_up(points, normal, s * vertical, size) for s in (1.0, -1.0)]
-            scores = [_up_score(points, vertices, faces, u) for u in ups]
-            k = int(scores[1][0] > scores[0][0])
-            up = ups[k]
-            notes["up"] = 0.5 * abs(scores[0][0] - scores[1][0])
-            notes["mass"], notes["feet"] = scores[k][1:]
-            notes["ground_turn"] = min(angle(up, vertical), angle(up, -vertical))
-            sure &= notes["up"] >= 1.0 and notes["ground_turn"] <= SURE_GROUND_TURN
-        # a long body's principal axes tilt with its neck and head (36 degrees on the bundled
-        # elk): off the file's axes, nothing pins its vertical down, so never claim it
-        sure &= upright or snapped
+        up, up_sure = _up(points, centre, normal, size, vertical, aligned, upright, notes)
+        sure &= up_sure
     if forward is None:
         fwd = unit(np.cross(normal, up))
         cue = _forward_cue(points, up, fwd, upright)
