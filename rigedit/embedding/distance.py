@@ -19,7 +19,7 @@ import numpy as np
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
-__all__ = ["DistanceField", "distance_field"]
+__all__ = ["DistanceField", "distance_field", "surface_samples"]
 
 #: Cells along the longest side of the mesh's bounding box. 128 keeps a limb 4 cm thick on a
 #: 2 m character at a few cells across, and the whole field under a second at 50k vertices.
@@ -83,7 +83,7 @@ class DistanceField:
         return np.all(d > margin, axis=1)
 
 
-def _surface_samples(vertices, faces, spacing, rng):
+def surface_samples(vertices, faces, spacing, rng):
     """Vertices plus random points on faces, about ``spacing`` apart, (S, 3) float64."""
     tri = vertices[faces]
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
@@ -201,7 +201,7 @@ def distance_field(vertices, faces, resolution=RESOLUTION, seed=0):
     # the nearest of a dense sampling of the surface, a third of a cell apart.
     band = ndimage.binary_dilation(inside, iterations=2) & ~deep
     idx = np.argwhere(band)
-    dense = _surface_samples(vertices, faces, h / 3.0, np.random.default_rng(seed))
+    dense = surface_samples(vertices, faces, h / 3.0, np.random.default_rng(seed))
     dist, near = cKDTree(dense).query(origin + idx * h, workers=1)
     sign = np.where(inside[tuple(idx.T)], 1.0, -1.0)
     depth[tuple(idx.T)] = sign * dist

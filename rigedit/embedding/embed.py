@@ -15,6 +15,7 @@ import numpy as np
 from .distance import distance_field
 from .fit import W_SCALE_FIRM, W_SCALE_WEAK, fit_joints
 from .graph import medial_graph
+from .inside import keep_inside
 from .medial import medial_cells, pack_spheres
 from .place import place_carried, place_chains
 from .search import discrete_embedding
@@ -51,6 +52,13 @@ class Embedding:
         Mesh units per template unit found.
     spheres : (S, 4) float64
         The medial spheres (centre, radius), for display and debugging.
+    shortened : dict[str, float]
+        Carried branches (by their first joint) shortened to stay inside the mesh -> the
+        fraction of the template's length kept.
+    outside : list[str]
+        Joints of carried branches with no geometry around them (they would stick out of
+        the mesh even when short): collapsed into their base joint's region; they should
+        not deform the skin.
     """
 
     positions: np.ndarray
@@ -59,6 +67,8 @@ class Embedding:
     placed: list = field(default_factory=list)
     scale: float = 1.0
     spheres: np.ndarray = None
+    shortened: dict = field(default_factory=dict)
+    outside: list = field(default_factory=list)
 
 
 def _check_mesh(vertices, faces):
@@ -182,6 +192,11 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None)
     placed_mask = np.zeros(len(out), dtype=bool)
     for r in np.flatnonzero(ok):
         placed_mask[reduced.chains[r][1:] if r else [reduced.joints[0]]] = True
+    t0 = time.perf_counter()
+    out, cut, gone = keep_inside(field_, out, reduced.parents, placed_mask, vertices, faces)
+    seconds["placement"] += time.perf_counter() - t0
     placed = [template.names[j] for j in np.flatnonzero(placed_mask)]
     return Embedding(out, seconds, float(found.cost), placed, float(scale),
-                     np.c_[graph.points, graph.radii])
+                     np.c_[graph.points, graph.radii],
+                     {template.names[j]: s for j, s in cut.items()},
+                     [template.names[j] for j in gone])
