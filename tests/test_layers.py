@@ -6,10 +6,14 @@ GUI = ("PyQt5", "pyvista", "pyvistaqt", "vtk", "vtkmodules", "qtpy")
 
 
 def test_pure_packages_import_no_gui_modules():
-    code = ("import sys, rigedit, rigedit.model, rigedit.animation, rigedit.io, rigedit.rig, "
-            "rigedit.cli, rigedit.undo, rigedit.recovery\n"
-            "import importlib.util\n"
-            "if importlib.util.find_spec('rigedit.document'): import rigedit.document\n"
+    # every module of the pure packages, not only their __init__: a GUI import hidden in a
+    # submodule that the package does not import at once would slip past otherwise
+    code = ("import sys, importlib, pkgutil, rigedit, rigedit.rig, rigedit.cli, rigedit.undo, "
+            "rigedit.recovery, rigedit.document\n"
+            "for pkg in ('model', 'animation', 'io', 'rigging', 'embedding'):\n"
+            "    package = importlib.import_module('rigedit.' + pkg)\n"
+            "    for info in pkgutil.iter_modules(package.__path__):\n"
+            "        importlib.import_module(f'rigedit.{pkg}.{info.name}')\n"
             f"bad = [m for m in sys.modules if m.split('.')[0] in {GUI!r}]\n"
             "print(','.join(sorted(bad)))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
