@@ -376,13 +376,19 @@ def _assert_carried_bones_inside(emb, skeleton, vertices, faces):
     assert away.max() < 1.5 * h, away.max() / h
 
 
+def _antlerless(quadruped):
+    """The bundled quadruped's faces without those skinned mostly to the antlers."""
+    antler = np.array(["antler" in n for n in quadruped.skeleton.names])
+    b = quadruped.binding
+    top = b.indices[np.arange(len(quadruped.vertices)), np.argmax(b.weights, axis=1)]
+    return quadruped.faces[~antler[top][quadruped.faces].any(axis=1)]
+
+
 def test_an_antlerless_quadruped_has_its_carried_antlers_collapsed_and_reported(
         quadruped, own_quadruped):
     names = quadruped.skeleton.names
     antler = np.array(["antler" in n for n in names])
-    b = quadruped.binding
-    top = b.indices[np.arange(len(quadruped.vertices)), np.argmax(b.weights, axis=1)]
-    faces = quadruped.faces[~antler[top][quadruped.faces].any(axis=1)]  # antlers cut off
+    faces = _antlerless(quadruped)
     emb = _embed((quadruped.vertices, faces), quadruped)
     assert emb.outside == [n for n in names if "antler" in n]
     assert not any("antler" in n for n in emb.placed)
@@ -398,6 +404,21 @@ def test_an_antlerless_quadruped_has_its_carried_antlers_collapsed_and_reported(
     truth = quadruped.skeleton.bind_matrices[antler, :3, 3]
     err = np.linalg.norm(own_quadruped.positions[antler] - truth, axis=1)
     assert err.max() < 0.03 * _diagonal(quadruped.vertices)  # measured 4 cm of a 2.8 m diagonal
+
+
+def test_autorig_stops_joints_without_geometry_deforming_and_says_so(quadruped):
+    rig = rigedit.autorig((quadruped.vertices, _antlerless(quadruped)), template="quadruped",
+                          weights="idw", clips=False)
+    outside = rig.autorig_report.outside
+    assert outside and all("antler" in n for n in outside)
+    deform = dict(zip(rig.skeleton.names, rig.skeleton.deform))
+    assert not any(deform[n] for n in outside)
+    assert deform["head"] and deform["ear_L"] and len(rig.skeleton.names) == len(
+        quadruped.skeleton.names)                          # the joints are all still there
+    assert any(line.endswith(": no geometry, not deforming") and "antler_L_" in line
+               for line in rig.autorig_report.lines())
+    used = np.unique(rig.binding.indices[rig.binding.weights > 0])
+    assert not set(used) & {rig.skeleton.names.index(n) for n in outside}
 
 
 def test_a_carried_branch_is_shortened_in_proportion_until_inside():

@@ -193,7 +193,8 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None)
     for r in np.flatnonzero(ok):
         placed_mask[reduced.chains[r][1:] if r else [reduced.joints[0]]] = True
     t0 = time.perf_counter()
-    out, cut, gone = keep_inside(field_, out, reduced.parents, placed_mask, vertices, faces)
+    out, cut, gone = keep_inside(field_, out, reduced.parents, placed_mask, vertices, faces,
+                               reduced.mirror_all)
     seconds["placement"] += time.perf_counter() - t0
     placed = [template.names[j] for j in np.flatnonzero(placed_mask)]
     return Embedding(out, seconds, float(found.cost), placed, float(scale),

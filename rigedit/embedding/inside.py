@@ -94,7 +94,7 @@ def _turns(direction):
     return out
 
 
-def keep_inside(field, positions, parents, placed, vertices, faces):
+def keep_inside(field, positions, parents, placed, vertices, faces, mirror=None):
     """Turn, shorten or collapse the carried branches that leave the mesh.
 
     A branch leaving the mesh is first turned about its base (up to ``TURNS[-1]`` degrees:
@@ -115,6 +115,9 @@ def keep_inside(field, positions, parents, placed, vertices, faces):
     vertices : (V, 3) float64
     faces : (F, 3) int
         The mesh.
+    mirror : (J,) int, optional
+        Each joint's mirror image (-1: none): when one of two mirrored branches has no
+        geometry, neither has.
 
     Returns
     -------
@@ -126,8 +129,8 @@ def keep_inside(field, positions, parents, placed, vertices, faces):
         Joints of the collapsed branches (no geometry there), in joint order.
     """
     out = np.array(positions, dtype=np.float64)
-    shortened, outside = {}, []
     away = _Outside(field, vertices, faces)
+    fitted, collapsed = {}, {}       # branch root -> (joints, positions, kept fraction)
     for base, joints in _branches(parents, placed):
         b = out[base]
         offsets = out[joints] - b
@@ -149,15 +152,25 @@ def keep_inside(field, positions, parents, placed, vertices, faces):
         found = next(((float(s), turn) for s in _STEPS for turn in
                       (turns if s >= TURN_LENGTH else turns[:1])
                       if fits(b + s * turn.apply(offsets))), None)
-        if found is None:
-            keep = min(SHORTEST, COLLAPSED * radius / longest)
-            out[joints] = b + keep * offsets
+        keep = min(SHORTEST, COLLAPSED * radius / longest)
+        collapsed[joints[0]] = (joints, b + keep * offsets, keep)
+        if found is not None:
+            fitted[joints[0]] = (joints, b + found[0] * found[1].apply(offsets), found[0])
+    shortened, outside = {}, []
+    root_of = {j: root for root, (joints, _, _) in collapsed.items() for j in joints}
+    for root, (joints, pts, keep) in collapsed.items():
+        # one side of a mirror pair without geometry: the other fitting is chance (a hole's
+        # edge, the body beside it), as meshes are near symmetric. Branches are mirrored when
+        # any of their joints are (the bases of antlers lie too near the middle to count).
+        twins = set() if mirror is None else {root_of.get(int(mirror[j]), root)
+                                              for j in joints if mirror[j] >= 0}
+        if root in fitted and all(t in fitted for t in twins):
+            joints, pts, keep = fitted[root]
+            if keep < 1.0:
+                shortened[root] = keep
+        else:
             outside += joints
-            continue
-        keep, turn = found
-        if keep < 1.0:
-            shortened[joints[0]] = keep
-        out[joints] = b + keep * turn.apply(offsets)
+        out[joints] = pts
     return out, shortened, sorted(outside)
 
 

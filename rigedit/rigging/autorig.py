@@ -68,6 +68,9 @@ class AutorigReport:
     template_pose : str
         The template pose embedded: ``"rest"``, or a clip's first frame (see
         :func:`template_poses`).
+    outside : list[str]
+        Carried template joints with no geometry around them (collapsed by the embedding
+        into their base's region): kept, for the clips, but not deforming.
     """
 
     source: str
@@ -80,6 +83,7 @@ class AutorigReport:
     placed: list = field(default_factory=list)
     clips: dict = field(default_factory=dict)
     template_pose: str = "rest"
+    outside: list = field(default_factory=list)
 
     def lines(self):
         """The report as short lines (the CLI prints them)."""
@@ -93,6 +97,9 @@ class AutorigReport:
         out += list(self.checks.lines())
         out.append(f"embedding: template {self.template} ({self.template_pose} pose), "
                    f"{len(self.placed)} joints placed from the mesh, cost {self.cost:.4g}")
+        if self.outside:
+            from ..embedding.inside import describe_joints
+            out.append(f"{describe_joints(self.outside)}: no geometry, not deforming")
         for name, how in self.clips.items():
             out.append(f"clip {name}: {how}")
         out.append("seconds: " + ", ".join(f"{k} {v:.2f}" for k, v in self.seconds.items()))
@@ -281,6 +288,7 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
 
     t0 = time.perf_counter()
     skeleton = build_skeleton(t_sk, emb.positions)
+    skeleton.deform[[skeleton.names.index(n) for n in emb.outside]] = False
     seconds["skeleton"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
@@ -309,6 +317,7 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     band("clips")(1.0)
     seconds["total"] = time.perf_counter() - t_all
     rig.autorig_report = AutorigReport(source, t_name, orientation, place, checks, seconds,
-                                       emb.cost, list(emb.placed), clip_notes, t_pose)
+                                       emb.cost, list(emb.placed), clip_notes, t_pose,
+                                       list(emb.outside))
     rig.notes["autorig"] = (f"template {t_name}; orientation {orientation.describe()}")
     return rig
