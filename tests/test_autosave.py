@@ -124,9 +124,11 @@ def test_background_write_keeps_the_state_it_started_from(make_editor, qtbot, mo
     assert auto.tick()
     doc.mark_saved()
     assert auto.busy
-    gate.set()
-    qtbot.waitUntil(lambda: not auto.busy, timeout=10000)
-    qtbot.wait(100)  # the thread's signal
+    # the thread's signal is queued to the UI thread, where its handler (connected first)
+    # removes the entry: wait for the signal itself, not a fixed time
+    with qtbot.waitSignal(auto._written_in_thread, timeout=10000):
+        gate.set()
+    assert not auto.busy
     assert _entries() == [] and auto.writes == 2
     # Closed while a write runs: the close waits for it and leaves nothing.
     gate.clear()

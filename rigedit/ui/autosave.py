@@ -57,8 +57,8 @@ class Autosave(QtCore.QObject):
         Snapshots written so far.
     """
 
-    # (generation, revision written, error message or None), from the writer thread
-    _written_in_thread = QtCore.pyqtSignal(int, int, object)
+    # (generation, revision written, error message or None, the thread), from the writer thread
+    _written_in_thread = QtCore.pyqtSignal(int, int, object, object)
 
     _windows = 0
 
@@ -72,7 +72,7 @@ class Autosave(QtCore.QObject):
         self._lock = threading.Lock()  # one writer of the entry folder at a time
         self._thread = None
         self._generation = 0  # a discard makes the results of earlier writes stale
-        self._written_in_thread.connect(self._thread_done)
+        self._written_in_thread.connect(self._thread_signalled)
         self.timer = QtCore.QTimer(self)
         self.timer.timeout.connect(self.tick)
         window.document.subscribe(self._on_document)
@@ -152,7 +152,13 @@ class Autosave(QtCore.QObject):
         except Exception as exc:  # noqa: BLE001 - logged and shown, never a silent thread death
             errors_hook.logger().error("autosave failed", exc_info=True)
             error = f"{type(exc).__name__}: {exc}"
-        self._written_in_thread.emit(generation, revision, error)
+        self._written_in_thread.emit(generation, revision, error, threading.current_thread())
+
+    def _thread_signalled(self, generation, revision, error, thread):
+        # The signal is the thread's last act, but it may arrive before the thread has ended:
+        # :attr:`busy` must not count it (else a save made during the write left its entry behind).
+        thread.join()
+        self._thread_done(generation, revision, error)
 
     def _thread_done(self, generation, revision, error):
         if generation != self._generation:  # discarded while it wrote
