@@ -164,7 +164,7 @@ POSES = {
                               "LeftLeg": [50, 0, 0], "RightLeg": [50, 0, 0],
                               "LeftFoot": [-20, 0, 0], "RightFoot": [-20, 0, 0],
                               "Spine": [10, 0, 0]}, 2.5),  # 1.66
-    ("quadruped", "head down"): ({"neck_1": [25, 0, 0]}, 3.4),  # 1.77 (2.25 unturned)
+    ("quadruped", "head down"): ({"neck_1": [25, 0, 0]}, 3.4),  # 1.76 (2.25 unturned)
     ("quadruped", "crouch"): ({"hind_thigh_L": [-15, 0, 0], "hind_thigh_R": [-15, 0, 0],
                                "hind_shin_L": [20, 0, 0], "hind_shin_R": [20, 0, 0],
                                "fore_upper_L": [15, 0, 0], "fore_upper_R": [15, 0, 0],
