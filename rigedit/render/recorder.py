@@ -247,7 +247,9 @@ class FrameReader:
     Parameters
     ----------
     plotter : pyvista.Plotter
-        Rendered off-screen at least once (pyvista's ``render()`` does nothing before that).
+        Rendered off-screen at least once (pyvista's ``render()`` does nothing before that),
+        and with ``backdrop`` its last render shows the scene as it is now (the reference
+        the backdrop's compositing must reproduce).
     buffers : int
         How many frames may be in use at once (queued for the encoder): a buffer is written
         again only after ``buffers - 1`` further reads.
@@ -275,7 +277,7 @@ class FrameReader:
 
     def _capture_backdrop(self):
         plotter, renderer = self.plotter, self.plotter.renderer
-        plotter.render()
+        # the frame the caller last rendered (the scene as it is): no render of our own
         reference = self.image(self.read()).copy()
         shown = [(actor, actor.GetVisibility()) for actor in renderer.GetActors()]
         for actor, _ in shown:
