@@ -18,7 +18,11 @@ Prints the best rate, the spread (worst-best) and the process CPU time per frame
 process with its threads, llvmpipe's included; ffmpeg runs in its own), then the ratio
 achieved / bare. record_clip's rate counts the whole call (plotter, scene and ffmpeg set-up,
 framing, closing the file); the line under it counts its frame loop alone (from the first
-frame's progress call to the last), as the bare plotter's rate does. ``--configs`` adds the
+frame's progress call to the last), as the bare plotter's rate does. Then record_clip's set-up
+(to the end of its first frame) and the time after its last frame (ffmpeg's flush), and the
+CPU-bound ratio: the bare plotter's CPU per frame over record_clip's plus ffmpeg's, the rate
+ratio to expect when other jobs keep every core busy (the wall-rate ratio then swings with
+how the scheduler shares the cores between the processes). ``--configs`` adds the
 older table's other settings (medium preset, no floor, 4x MSAA, GIF). ``--compare-with
 OLD.py`` also times another version of ``rigedit/render/recorder.py`` in the same run (for
 example ``git show COMMIT:rigedit/render/recorder.py > /tmp/old_recorder.py``).
@@ -128,7 +132,9 @@ def recorded(rig, clip, path, frames, fps, size, module=None, **options):
         encoder_cpu.append((f1.ru_utime + f1.ru_stime - f0.ru_utime - f0.ru_stime) / n)
     (w1, c1), (w2, c2) = stamps[0], stamps[-1]
     loop = ((n - 1) / (w2 - w1), (c2 - c1) / (n - 1))
-    return (n / wall, cpu / n), loop
+    # seconds to the end of the first frame, and after the last one
+    edge = (w1 - t0, t0 + wall - w2)
+    return (n / wall, cpu / n), loop, edge
 
 
 def summary(rates):
@@ -171,14 +177,18 @@ def main(argv=None):
     runs = {label: [] for label in ["bare plotter (skin, draw, read back)"]
             + [c[0] for c in configs]}
     bare(rig, clip, 5, args.fps, size)  # warm-up: kernels, GL context
+    edges = []
     with tempfile.TemporaryDirectory() as tmp:
         for _ in range(args.repeat):
             runs["bare plotter (skin, draw, read back)"].append(
                 bare(rig, clip, args.frames, args.fps, size))
             for label, suffix, options in configs:
                 path = Path(tmp) / f"bench{suffix}"
-                whole, loop = recorded(rig, clip, path, args.frames, args.fps, size, **options)
+                whole, loop, edge = recorded(rig, clip, path, args.frames, args.fps, size,
+                                             **options)
                 runs[label].append(whole)
+                # the default configuration's set-up, close and ffmpeg CPU per frame
+                edges.append(edge + (encoder_cpu[-1],)) if label == configs[0][0] else None
                 runs.setdefault(f"  frames 2-{args.frames} only", []).append(loop) \
                     if label == configs[0][0] else None
     order = list(runs)
@@ -195,6 +205,13 @@ def main(argv=None):
     print(f"  achieved / bare: {r[0] / b[0]:.2f} (best rates); CPU per frame "
           f"{r[2] / b[2]:.2f}x the bare plotter's (load average now "
           f"{os.getloadavg()[0]:.1f})")
+    first, last = (min(e[k] for e in edges) for k in (0, 1))
+    print(f"  record_clip's set-up to the first frame's end {first:.2f} s, after the last frame "
+          f"(ffmpeg's flush, closing) {last:.2f} s (best)")
+    # when every core is busy (other jobs), rates follow CPU time: the bare plotter's CPU per
+    # frame over the recorder's plus ffmpeg's is the ratio a CPU-bound machine allows
+    print(f"  CPU-bound ratio bare CPU / (record_clip CPU + ffmpeg CPU) per frame: "
+          f"{b[2] / (r[2] + min(e[2] for e in edges)):.2f}")
 
 
 if __name__ == "__main__":
