@@ -212,15 +212,15 @@ class AutorigAction:
         """Auto-rig ``mesh`` off the UI thread; the result becomes the document. Returns
         the job (None when another job runs)."""
         mesh = Path(mesh)
+        check = self.w.files.replacing("auto-rigging a mesh")
+        if check is None:
+            return None
         relay = self.relay
         self._label = f"Auto-rigging {mesh.name}"
 
         def work(report):
-            import rigedit
+            from rigedit import autorig
 
-            autorig = getattr(rigedit, "autorig", None)
-            if autorig is None:
-                raise ValueError("auto-rigging is not available in this installation")
             last = [None]
 
             def progress(fraction, stage=None):
@@ -233,9 +233,11 @@ class AutorigAction:
             return autorig(str(mesh), template=template, up=up, forward=forward,
                            progress=progress)
 
-        return self.w.run_job(self._label, work, lambda rig: self._done(mesh, rig))
+        return self.w.run_job(self._label, work, lambda rig: self._done(mesh, rig, check))
 
-    def _done(self, mesh, rig):
+    def _done(self, mesh, rig, check=lambda: True):
+        if not check():
+            return None
         rig.path = None  # a new document: Save asks where
         if not rig.name:
             rig.name = mesh.stem

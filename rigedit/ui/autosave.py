@@ -274,13 +274,15 @@ def recover(window, entry):
 
 
 # ---------------------------------------------------------------------- closing
-def ask_save_changes(window):
-    """Ask about unsaved changes on close: "save", "discard" or "cancel"."""
+def ask_save_changes(window, action="closing"):
+    """Ask about unsaved changes before ``action`` ("closing", "opening another rig", ...):
+    "save", "discard" or "cancel"."""
     box = QtWidgets.QMessageBox(window)
     box.setIcon(QtWidgets.QMessageBox.Warning)
     box.setWindowTitle("Unsaved changes")
-    box.setText(f"Save the changes to {window.document.rig.name} before closing?")
-    box.setInformativeText("Closing without saving loses them (no recovery file is kept).")
+    box.setText(f"Save the changes to {window.document.rig.name} before {action}?")
+    box.setInformativeText(f"{action[:1].upper()}{action[1:]} without saving loses them "
+                           "(no recovery file is kept).")
     box.setStandardButtons(QtWidgets.QMessageBox.Save | QtWidgets.QMessageBox.Discard
                            | QtWidgets.QMessageBox.Cancel)
     box.setDefaultButton(QtWidgets.QMessageBox.Save)
@@ -289,12 +291,13 @@ def ask_save_changes(window):
             QtWidgets.QMessageBox.Discard: "discard"}.get(answer, "cancel")
 
 
-def confirm_unsaved_changes(window, ask=None):
-    """Whether the window may close: no unsaved changes, or the user discarded them, or
-    they were saved (File > Save; Save As when there is no folder to save to)."""
+def confirm_unsaved_changes(window, ask=None, action="closing"):
+    """Whether the window may close (or its document be replaced: ``action`` says by what,
+    e.g. "opening another rig"): no unsaved changes, or the user discarded them, or they
+    were saved (File > Save; Save As when there is no folder to save to)."""
     if not window.document.modified:
         return True
-    choice = (ask or ask_save_changes)(window)
+    choice = (ask or ask_save_changes)(window, action=action)
     if choice == "save":
         return bool(window.files.save()) and not window.document.modified
     return choice == "discard"

@@ -13,6 +13,7 @@ from ..io.rig_folder import load_rig_folder, save_rig_folder
 from ..io.rig_save import is_bundled
 from ..io.skeleton_json import save_skeleton
 from ..io.weights_npz import load_weights, save_weights
+from .autosave import confirm_unsaved_changes
 from .jobs import weights_in_chunks
 
 __all__ = ["FileActions", "pose_to_dict"]
@@ -66,17 +67,49 @@ class FileActions:
         path, _ = QtWidgets.QFileDialog.getSaveFileName(self.w, title, name, filters)
         return path or None
 
+    # ------------------------------------------------------------------ replacing the document
+    def may_replace(self, action):
+        """Whether the open document may be replaced (``action``: by what, for the question):
+        no unsaved changes, or the user saved or discarded them. Asked where closing asks
+        (``confirm_close``: the app; not scripts or tests driving the window)."""
+        return not self.w.confirm_close or confirm_unsaved_changes(self.w, action=action)
+
+    def replacing(self, action):
+        """Ask before reading a new document in the background; returns None when the user
+        keeps the open one, else a check for the moment the new one arrives: edits made
+        meanwhile are asked about again, so reading a file never drops them silently."""
+        if not self.may_replace(action):
+            return None
+        doc = self.doc
+        rig, top = doc.rig, doc.undo_stack.top
+
+        def still_ok():
+            if doc.rig is rig and doc.undo_stack.top is top:
+                return True  # nothing changed since the question
+            if self.may_replace(action):
+                return True
+            self.w.status(f"Kept {doc.rig.name}: {action} cancelled")
+            return False
+
+        return still_ok
+
     # ------------------------------------------------------------------ open
     def open_folder(self, path=None):
         """Open a rig folder (mesh, skeleton.json, optional weights and animations)."""
+        check = self.replacing("opening another rig")
+        if check is None:
+            return None
         path = path or QtWidgets.QFileDialog.getExistingDirectory(self.w, "Open rig folder")
         if not path:
             return None
         return self.w.run_job(f"Opening {Path(path).name}", lambda report: _load_folder(path),
-                              self._opened)
+                              lambda rig: self._opened(rig, check))
 
     def open_mesh_skeleton(self, mesh_path=None, skeleton_path=None):
         """Open a mesh file and a skeleton file; weights are computed."""
+        check = self.replacing("opening another rig")
+        if check is None:
+            return None
         mesh_path = mesh_path or self._ask_open(
             "Open mesh", "Meshes (*.obj *.ply *.stl *.vtk *.vtu *.vtp)")
         if not mesh_path:
@@ -98,18 +131,24 @@ class FileActions:
             return Rig(skeleton, vertices, faces, indices, weights, name=Path(mesh_path).stem,
                        up=meta["up"])
 
-        return self.w.run_job(f"Opening {Path(mesh_path).name}", work, self._opened)
+        return self.w.run_job(f"Opening {Path(mesh_path).name}", work,
+                              lambda rig: self._opened(rig, check))
 
     def open_file(self, path=None):
         """Open a glTF/GLB file or a BVH file (a skeleton and its motion, no mesh)."""
+        check = self.replacing("opening another rig")
+        if check is None:
+            return None
         path = path or self._ask_open("Open glTF or BVH file",
                                       "Rigs and motion (*.glb *.gltf *.bvh)")
         if not path:
             return None
         return self.w.run_job(f"Opening {Path(path).name}", lambda report: _load_file(path),
-                              self._opened)
+                              lambda rig: self._opened(rig, check))
 
-    def _opened(self, rig):
+    def _opened(self, rig, check):
+        if not check():
+            return
         self.doc.set_rig(rig)
         notes = "".join(f"; {key}: {value}" for key, value in sorted(rig.notes.items()))
         self.w.status(f"Opened {rig.name}: {len(rig.vertices):,} vertices, "
