@@ -320,6 +320,41 @@ def test_homer_with_the_humanoid_template_stands_in_the_body(humanoid):
     assert p["Head"][1] > p["Spine2"][1] > p["Hips"][1] > p["LeftLeg"][1] > p["LeftFoot"][1]
     placed = [j for j, n in enumerate(humanoid.skeleton.names) if n in emb.placed]
     assert _inside_fraction(emb.positions[placed], vertices, faces) > 0.95
+    # thighs where the legs meet the trunk, not in the belly (they were half-way up his
+    # body, the knees at the crotch): the crotch, measured here as the lowest vertex on the
+    # middle plane above the ankles, is below them, and the knees half-way down the legs
+    plane = 0.5 * (p["LeftFoot"][0] + p["RightFoot"][0])
+    ankle = 0.5 * (p["LeftFoot"][1] + p["RightFoot"][1])
+    middle = (np.abs(vertices[:, 0] - plane) < 0.005 * height) & (vertices[:, 1] > ankle)
+    crotch = vertices[middle, 1].min()
+    for side in ("Left", "Right"):
+        thigh, knee = p[side + "UpLeg"][1], p[side + "Leg"][1]
+        assert crotch < thigh < crotch + 0.4 * (crotch - ankle)
+        assert 0.35 < (knee - ankle) / (thigh - ankle) < 0.65
+
+
+def test_thigh_height_from_the_crotch_keeps_the_templates_own(humanoid, quadruped):
+    from rigedit.embedding.distance import distance_field
+    from rigedit.embedding.legs import LEG_TOP, leg_top_heights, template_leg_top
+    from rigedit.embedding.template import reduce_template
+
+    reduced = reduce_template(humanoid.skeleton, (humanoid.vertices, humanoid.faces))
+    above = template_leg_top(reduced, humanoid.vertices, humanoid.faces)
+    assert 0.1 < above < 0.35  # the bundled humanoid's thighs sit above its crotch
+    field = distance_field(humanoid.vertices, humanoid.faces)
+    rest = reduced.rest
+    # the template's joints moved off (hips 20% too high): the crotch brings them back
+    moved = rest.copy()
+    moved[:, 1] += 0.2 * (moved[:, 1] - moved[:, 1].min())
+    heights = leg_top_heights(field, reduced, moved, rest[0, 0], above)
+    names = humanoid.skeleton.names
+    assert sorted(names[j] for j in heights) == ["LeftUpLeg", "RightUpLeg"]
+    for j, y in heights.items():
+        assert abs(y - rest[j, 1]) < 0.01 * np.ptp(rest[:, 1])
+    # a quadruped's hips are not a leg radius above where its legs part: left alone
+    reduced = reduce_template(quadruped.skeleton, (quadruped.vertices, quadruped.faces))
+    field = distance_field(quadruped.vertices, quadruped.faces)
+    assert leg_top_heights(field, reduced, reduced.rest, reduced.rest[0, 0], LEG_TOP) == {}
 
 
 # ------------------------------------------------------------------------------ bad input

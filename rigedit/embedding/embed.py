@@ -16,6 +16,7 @@ from .distance import distance_field
 from .fit import W_SCALE_FIRM, W_SCALE_WEAK, fit_joints
 from .graph import medial_graph
 from .inside import keep_inside
+from .legs import LEG_TOP, leg_top_heights, lower_leg_tops, template_leg_top
 from .medial import medial_cells, pack_spheres
 from .place import place_carried, place_chains
 from .search import discrete_embedding
@@ -188,6 +189,10 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None)
     chains = place_chains(reduced, positions, paths)
     out, scale = stage("refinement", 0.95, fit_joints, field_, reduced, chains, scale,
                        frame["floor"], hold, graph.points, frame["plane_x"])
+    # a deep trunk lifts the hips' sphere centre: the thighs go where the legs part
+    above = LEG_TOP if template_mesh is None else template_leg_top(reduced, *template_mesh)
+    out = lower_leg_tops(reduced, out, leg_top_heights(field_, reduced, out, frame["plane_x"],
+                                                       above))
     out = stage("placement", 1.0, place_carried, reduced, out, scale, frame["floor"])
     placed_mask = np.zeros(len(out), dtype=bool)
     for r in np.flatnonzero(ok):
