@@ -1,7 +1,8 @@
 """Where a character stands: the support line its feet touch, in its mirror plane.
 
 Used by :mod:`.orient` to level the ground under an upright figure and to find which way a
-long body (a quadruped) stands, all round. Small vector helpers for both live here too.
+long body (a quadruped) stands, all round, and by :mod:`.mirror`; the small plane helpers
+(:func:`tangents`, :func:`angle`) live here.
 """
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 
 from .calibrate import unit
 
-__all__ = ["support_up", "stands_on", "find_ground", "unit", "tangents", "angle"]
+__all__ = ["support_up", "stands_on", "find_ground", "tangents", "angle"]
 
 GROUND_DEGREES = 20.0
 GROUND_TOUCH = 0.005
@@ -67,7 +68,7 @@ def support_up(points, normal, up, size, level=None):
 
 def stands_on(points, flat, normal, size, centre, angle):
     """Whether the support line below, in direction ``angle`` in the mirror plane's
-    coordinates ``flat`` (N, 2), is ground the body stands on (see :func:`_support_up`)."""
+    coordinates ``flat`` (N, 2), is ground the body stands on (see :func:`support_up`)."""
     e1, e2 = tangents(normal)
     d = np.array([np.cos(angle), np.sin(angle)])
     along = np.array([-d[1], d[0]])
@@ -87,7 +88,7 @@ def stands_on(points, flat, normal, size, centre, angle):
 
 def find_ground(points, normal, size, centre):
     """The direction, all round the mirror plane, on which the body stands (see
-    :func:`_support_up`): (3,) pointing down, or None. Each direction where the touching
+    :func:`support_up`): (3,) pointing down, or None. Each direction where the touching
     surface peaks is refined to a tenth of a degree and tested; of those that pass, the one
     most surface touches wins, and only when it touches at least :data:`GROUND_LEAD` times
     what any other (more than 10 degrees away) does: hind hooves with antler tips may hold

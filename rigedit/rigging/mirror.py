@@ -8,7 +8,8 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.spatial import cKDTree
 
-from .ground import tangents, unit
+from .calibrate import unit
+from .ground import tangents
 
 __all__ = ["symmetry_plane", "surface_samples", "volume_centroid", "SAMPLES"]
 

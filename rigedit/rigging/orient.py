@@ -44,7 +44,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .ground import angle, find_ground, support_up, tangents, unit
+from .calibrate import unit
+from .ground import angle, find_ground, support_up, tangents
 from .mirror import surface_samples, symmetry_plane, volume_centroid
 
 __all__ = ["Orientation", "orient", "check_axes", "parse_axis", "axis_name", "SNAP_DEGREES"]
