@@ -190,7 +190,7 @@ class AxisHandles(LeftButtonDrag):
         e = np.eye(3)[k]
         anchor = self.position()
         s0 = closest_on_line(anchor, e, *self.ray(x, y))
-        self._grab = {"axis": k, "anchor": anchor, "s0": 0.0 if s0 is None else s0,
+        self._grab = {"item": k, "anchor": anchor, "s0": 0.0 if s0 is None else s0,
                       "last": anchor}
         self.set_grabbed(k)
         if self.on_start:
@@ -200,7 +200,7 @@ class AxisHandles(LeftButtonDrag):
         """The point of the axis line nearest the mouse ray, kept at the grab offset (the
         joint moves with the mouse, it does not jump to it); calls ``on_move(k, target)``."""
         grab = self._grab
-        k = grab["axis"]
+        k = grab["item"]
         e = np.eye(3)[k]
         s = closest_on_line(grab["anchor"], e, *self.ray(x, y))
         if s is not None:
@@ -208,15 +208,8 @@ class AxisHandles(LeftButtonDrag):
         if self.on_move:
             self.on_move(k, grab["last"].copy())
 
-    def end_drag(self):
-        grab, self._grab = self._grab, None
-        if grab is None:
-            return
-        try:
-            if self.on_end:
-                self.on_end(grab["axis"])
-        finally:
-            self.set_grabbed(None)
+    def _drag_ended(self):
+        self.set_grabbed(None)
 
     def remove(self):
         """Stop listening to the interactor (the actors go with the renderer)."""

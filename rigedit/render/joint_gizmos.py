@@ -166,7 +166,7 @@ class JointGizmos(LeftButtonDrag):
         z = world_to_display(self.renderer, c0)[2]
         if x is None:
             x, y = self.display_position(j)
-        self._grab = {"joint": j, "center": c0, "depth": z,
+        self._grab = {"item": j, "center": c0, "depth": z,
                       "at": display_to_world(self.renderer, x, y, z)}
         self.glyphs.set_state(active=j, hovered=None)
         if self.on_start:
@@ -176,7 +176,7 @@ class JointGizmos(LeftButtonDrag):
         """Move the dragged sphere to ``center`` (3,) and call ``on_move(j, center)``."""
         if self._grab is None:
             return
-        j = self._grab["joint"]
+        j = self._grab["item"]
         self.set_center(j, center)
         if self.on_move:
             self.on_move(j, np.array(center, dtype=float))
@@ -189,16 +189,9 @@ class JointGizmos(LeftButtonDrag):
             return
         self.drag_to(g["center"] + display_to_world(self.renderer, x, y, g["depth"]) - g["at"])
 
-    def end_drag(self):
-        """End the drag (``on_end(j)``); the sphere stays where the owner put it."""
-        grab, self._grab = self._grab, None
-        if grab is None:
-            return
-        try:
-            if self.on_end:
-                self.on_end(grab["joint"])
-        finally:
-            self.glyphs.set_state(active=None)
+    def _drag_ended(self):
+        """After ``on_end(j)`` (:meth:`end_drag`); the sphere stays where the owner put it."""
+        self.glyphs.set_state(active=None)
 
     def drag(self, j, center):
         """A whole drag of joint ``j`` to ``center`` in one call: start, one move, end."""

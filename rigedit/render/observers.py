@@ -75,10 +75,25 @@ class LeftButtonDrag:
     moves go to ``drag_to_pixel(x, y)``; the release to ``end_drag()``. Each event the drag
     takes is aborted (the camera never sees it) and asks the interactor to render. A move
     with no drag goes to ``hover(iren, x, y)`` and on to the camera. The class holds
-    ``_grab`` (None when no drag is under way).
+    ``_grab`` (None when no drag is under way; else a dict whose ``"item"`` is what was
+    grabbed) and calls the owner's ``on_end(item)`` and ``_drag_ended()`` at the release.
     """
 
     _grab = None
+
+    def end_drag(self):
+        """End the drag: ``on_end(item)``, then ``_drag_ended()`` even if that raised."""
+        grab, self._grab = self._grab, None
+        if grab is None:
+            return
+        try:
+            if self.on_end:
+                self.on_end(grab["item"])
+        finally:
+            self._drag_ended()
+
+    def _drag_ended(self):
+        """Draw the gizmo as no longer grabbed (after :meth:`end_drag`)."""
 
     def observe(self, iren, priority, what):
         """Start listening to ``iren``; returns the observer tags."""
