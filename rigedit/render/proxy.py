@@ -21,7 +21,7 @@ from scipy.spatial import cKDTree
 
 from ..model.skinning import SkinBinding
 
-__all__ = ["SkinProxy", "ProxyActor", "build_proxy", "PROXY_MIN_FACES", "PROXY_TARGET_FACES"]
+__all__ = ["SkinProxy", "ProxyActor", "build_proxy", "write_skin", "PROXY_MIN_FACES", "PROXY_TARGET_FACES"]
 
 #: Meshes with more triangles than this get a proxy: the bundled characters (50-60k
 #: triangles) drag at 15-20 frames/s in full here, a mesh 3x their size would not.
@@ -115,6 +115,17 @@ def build_proxy(binding, faces, target_faces=PROXY_TARGET_FACES):
                      len(faces))
 
 
+def write_skin(mesh, points, normals=None):
+    """Write skinned ``points`` (V, 3) and, if given, ``normals`` (V, 3) into ``mesh`` (a
+    PolyData with a "Normals" point array then) in place, and mark them changed for VTK."""
+    if normals is not None:
+        mesh.point_data["Normals"][:] = normals
+        mesh.GetPointData().GetNormals().Modified()
+    mesh.points[:] = points
+    mesh.GetPoints().Modified()
+    mesh.Modified()
+
+
 class ProxyActor:
     """A :class:`SkinProxy` drawn in a plotter: hidden until :meth:`set_visible`, sharing the
     full mesh actor's property (colour, display mode) and texture; its normals are skinned
@@ -159,16 +170,10 @@ class ProxyActor:
     def skin(self, palette, method="lbs"):
         """Skin the proxy with ``palette`` (J, 4, 4) into its actor's points and normals."""
         binding = self.proxy.binding
+        points, normals = binding.skin_with_normals(palette)
         if method == "dqs":   # its normals blended linearly: only seen while moving
-            normals = binding.skin_with_normals(palette)[1].copy()
-            points = binding.skin(palette, method="dqs")
-        else:
-            points, normals = binding.skin_with_normals(palette)
-        self.mesh.point_data["Normals"][:] = normals
-        self.mesh.GetPointData().GetNormals().Modified()
-        self.mesh.points[:] = points
-        self.mesh.GetPoints().Modified()
-        self.mesh.Modified()
+            points = binding.skin(palette, method="dqs")  # leaves the normals' buffer alone
+        write_skin(self.mesh, points, normals)
 
     def remove(self):
         self.plotter.remove_actor(self.actor, render=False)

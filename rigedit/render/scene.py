@@ -14,7 +14,7 @@ from scipy.spatial.transform import Rotation
 from ..model.kinematics import skinning_matrices
 from ..surface import display_texture
 from .floor import add_floor
-from .proxy import ProxyActor
+from .proxy import ProxyActor, write_skin
 
 __all__ = ["RigScene", "up_vector", "front_vector", "faces_to_vtk", "turn_about",
            "joint_points"]
@@ -401,14 +401,9 @@ class RigScene:
             palette = skinning_matrices(self.rig.skeleton, model)
             if self.skinned_normals:
                 self._bind_rest_normals()
-                points, normals = self.rig.binding.skin_with_normals(palette)
-                self.mesh.point_data["Normals"][:] = normals
-                self.mesh.GetPointData().GetNormals().Modified()
-                self.mesh.points[:] = points
+                write_skin(self.mesh, *self.rig.binding.skin_with_normals(palette))
             else:
-                self.mesh.points[:] = self.rig.binding.skin(palette, method=self.skinning)
-            self.mesh.GetPoints().Modified()
-            self.mesh.Modified()
+                write_skin(self.mesh, self.rig.binding.skin(palette, method=self.skinning))
         self.joint_positions[:] = model[:, :3, 3]
         self.bones.points[:] = self.joint_positions
         self.bones.GetPoints().Modified()
