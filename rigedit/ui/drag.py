@@ -72,7 +72,8 @@ class DragController:
     ----------
     drag : dict or None
         The drag under way: ``joint``, ``start`` (3,), ``axis``, ``pose`` (the snapshot at
-        the press), ``target`` (3,) once moved.
+        the press), ``target`` (3,) once moved, ``heads`` (J, 3) the rest heads shown by an
+        edit-mode drag.
     """
 
     def __init__(self, document, scene, gizmos, axes, settings, move_rest, status,
@@ -116,8 +117,11 @@ class DragController:
         if self.document.mode == "pose":
             self.step(j, target)
         else:
-            rig = self.document.rig
-            heads = rig.joint_matrices(rig.rest_pose())[:, :3, 3].copy()
+            heads = drag.get("heads")
+            if heads is None:   # the rest pose holds still during the drag: once per drag
+                rig = self.document.rig
+                heads = rig.joint_matrices(rig.rest_pose())[:, :3, 3].copy()
+                drag["heads"] = heads
             heads[j] = target
             self.scene.bones.points[:] = heads
             self.scene.bones.Modified()
