@@ -23,6 +23,25 @@ def cyl_rig():
     return cylinder_rig()
 
 
+# The bundled rigs, loaded once per test module (a module may change its copy).
+@pytest.fixture(scope="module")
+def humanoid():
+    import rigedit
+
+    return rigedit.load_rig("humanoid")
+
+
+@pytest.fixture(scope="module")
+def quadruped():
+    import warnings
+
+    import rigedit
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return rigedit.load_rig("quadruped")
+
+
 # ---------------------------------------------------------------------- UI test environment
 # The UI tests need pytest-qt and an X display (Xvfb, started by pytest-xvfb). When either is
 # missing they must FAIL, never skip: a skipped UI suite looks green. pytest-xvfb itself only

@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-import rigedit
 from rigedit.model import Skeleton
 from rigedit.rig import Rig
 
@@ -99,10 +98,6 @@ def renamed(name):
     if name.endswith(("_L", "_R")):
         name, side = name[:-2], "." + name[-1].lower()
     return "Q_" + "".join(w.capitalize() for w in name.split("_")) + side
-
-
-def quadruped():
-    return rigedit.load_rig("quadruped")
 
 
 def level_pitch(skeleton, **kw):

@@ -1,7 +1,6 @@
 """RigScene: normals skinned with the vertices, and the opaque floor (issue 12, section 1)."""
 from __future__ import annotations
 
-import warnings
 
 import numpy as np
 import pytest
@@ -13,15 +12,6 @@ from rigedit.render.scene import RigScene  # noqa: E402
 
 SIZE = (640, 400)
 BACKGROUND = ("#3a3f47", "#1d2026")  # the editor's
-
-
-@pytest.fixture(scope="module")
-def quadruped():
-    import rigedit
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return rigedit.load_rig("quadruped")
 
 
 @pytest.fixture

@@ -1,7 +1,6 @@
 """The decimated proxy of a big mesh (issue 12, section 1): built, bound, drawn while moving."""
 from __future__ import annotations
 
-import warnings
 
 import numpy as np
 import pytest
@@ -13,15 +12,6 @@ from rigedit.model.kinematics import skinning_matrices  # noqa: E402
 from rigedit.model.subdivide import subdivide_centroid  # noqa: E402
 from rigedit.render.proxy import build_proxy  # noqa: E402
 from rigedit.render.scene import RigScene  # noqa: E402
-
-
-@pytest.fixture(scope="module")
-def quadruped():
-    import rigedit
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return rigedit.load_rig("quadruped")
 
 
 @pytest.fixture(scope="module")
