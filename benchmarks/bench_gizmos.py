@@ -38,22 +38,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import numpy as np  # noqa: E402
 
 import rigedit  # noqa: E402  (imported before profile_drag puts this tree first on the path)
-from profile_drag import _limb_joint, _median_ms, drag, open_editor  # noqa: E402
-
-
-def wall_and_cpu_ms(fn, n=15, warm=2):
-    """Median wall and CPU milliseconds of ``fn()``; the CPU time is this process's, all
-    threads (llvmpipe draws on several), so other jobs on the machine inflate it far less
-    than the wall time."""
-    for _ in range(warm):
-        fn()
-    wall, cpu = [], []
-    for _ in range(n):
-        w0, c0 = time.perf_counter(), time.process_time()
-        fn()
-        cpu.append(time.process_time() - c0)
-        wall.append(time.perf_counter() - w0)
-    return float(np.median(wall) * 1e3), float(np.median(cpu) * 1e3)
+from profile_drag import (_limb_joint, _median_ms, drag, open_editor,  # noqa: E402
+                          wall_and_cpu_ms)
 
 
 def old_widgets(w):
