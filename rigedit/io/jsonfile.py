@@ -91,10 +91,6 @@ def read_json(path):
                                  "than the parser allows") from None
 
 
-def _where(key, where):
-    return f"{key!r}{where}" if key is not None else where.strip() or "value"
-
-
 def require(path, obj, key, kind, where=""):
     """``obj[key]`` checked to be of ``kind`` (bool never counts as int or float)."""
     if not isinstance(obj, dict):
