@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ..model.ik import rotation_between
+
 __all__ = ["least_rotation", "place_chains", "place_carried"]
 
 
@@ -23,17 +25,7 @@ def least_rotation(a, b):
     la, lb = np.linalg.norm(a), np.linalg.norm(b)
     if la < 1e-12 or lb < 1e-12 or not np.isfinite(la * lb):
         return Rotation.identity()  # a zero-length bone has no direction to turn
-    a = np.asarray(a, float) / la
-    b = np.asarray(b, float) / lb
-    axis = np.cross(a, b)
-    s, c = np.linalg.norm(axis), float(np.dot(a, b))
-    if s < 1e-12:
-        if c > 0:
-            return Rotation.identity()
-        # opposite: half a turn about any axis perpendicular to a
-        perp = np.cross(a, [1.0, 0, 0] if abs(a[0]) < 0.9 else [0, 1.0, 0])
-        return Rotation.from_rotvec(np.pi * perp / np.linalg.norm(perp))
-    return Rotation.from_rotvec(axis / s * np.arctan2(s, c))
+    return rotation_between(np.asarray(a, float), np.asarray(b, float))
 
 
 def _along(polyline, fractions):

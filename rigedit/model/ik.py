@@ -16,7 +16,7 @@ from scipy.spatial.transform import Rotation
 
 from .kinematics import local_to_model
 
-__all__ = ["fabrik", "aim_joint", "ik_chain", "solve_chain", "drag_joint"]
+__all__ = ["fabrik", "aim_joint", "ik_chain", "solve_chain", "drag_joint", "rotation_between"]
 
 
 def fabrik(positions, target, tolerance=1e-6, max_iterations=30):
@@ -67,7 +67,7 @@ def _unit(v):
     return v / n if n > 1e-12 else np.array([0.0, 1.0, 0.0])
 
 
-def _rotation_between(a, b):
+def rotation_between(a, b):
     """Smallest rotation taking direction ``a`` to direction ``b``, as a :class:`Rotation`."""
     a, b = _unit(a), _unit(b)
     axis = np.cross(a, b)
@@ -98,7 +98,7 @@ def aim_joint(skeleton, pose, model_mats, joint, child_pos, target):
         Model-space points.
     """
     head = model_mats[joint, :3, 3]
-    delta = _rotation_between(np.asarray(child_pos) - head, np.asarray(target) - head)
+    delta = rotation_between(np.asarray(child_pos) - head, np.asarray(target) - head)
     parent = skeleton.parents[joint]
     if parent >= 0:
         lin = model_mats[parent, :3, :3]
