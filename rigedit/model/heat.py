@@ -35,6 +35,7 @@ from . import laplacian as lap
 from .skinning import top_k_influences
 from .tails import bone_segments_with_tails, deforming_joints, infer_leaf_tails
 from .visibility import SurfaceRays
+from .weights import inverse_distance_weights, point_segment_distance
 
 try:  # CHOLMOD: measured faster than SuperLU (see benchmarks/bench_weights.py)
     from sksparse.cholmod import cholesky as _cholmod
@@ -120,7 +121,6 @@ def _joint_distances(points, starts, ends, owners, joints, dist=None, seg=None,
     seg : (N, J') int32
         Index into the segments of the nearest one per joint.
     """
-    from .weights import point_segment_distance
     if dist is None:
         dist = np.empty((len(points), len(joints)))
         seg = np.empty((len(points), len(joints)), np.int32)
@@ -148,12 +148,6 @@ def _nearest_on_segment(points, starts, ends):
     l2 = np.einsum("ij,ij->i", seg, seg)
     t = np.einsum("ij,ij->i", points - starts, seg) / np.where(l2 > 0, l2, 1.0)
     return starts + np.clip(t, 0.0, 1.0)[:, None] * seg
-
-
-def _inverse_distance(dist, k):
-    """Weights ``1 / (d / d_min)^4``, top ``k``: the fallback (rigedit's idw rule)."""
-    d = dist / np.maximum(dist.min(axis=1, keepdims=True), 1e-12)
-    return top_k_influences(1.0 / (np.square(d * d) + 1e-6), k)
 
 
 def _factor_solve(A, B, solver="auto"):
@@ -324,7 +318,7 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
         solvable[weak] = False
     fallback_w = np.flatnonzero(~solvable)
     if len(fallback_w):
-        fi, fv = _inverse_distance(dist[fallback_w], k)
+        fi, fv = inverse_distance_weights(dist[fallback_w], k)  # rigedit's idw rule
         idx[fallback_w], val[fallback_w] = joints[fi], fv
     idx[solvable] = joints[idx[solvable]]
     if k > 1 and min_weight > 0:

@@ -5,7 +5,8 @@ import numpy as np
 
 from .skinning import top_k_influences
 
-__all__ = ["METHODS", "compute_weights", "idw_weights", "point_segment_distance", "default_method"]
+__all__ = ["METHODS", "compute_weights", "idw_weights", "inverse_distance_weights",
+           "point_segment_distance", "default_method"]
 
 
 def point_segment_distance(points, starts, ends, out=None):
@@ -41,6 +42,29 @@ def point_segment_distance(points, starts, ends, out=None):
     d2 -= a
     np.maximum(d2, 0.0, out=d2)  # rounding can leave tiny negatives
     return np.sqrt(d2, out=d2)
+
+
+def inverse_distance_weights(dist, k, power=4.0, eps=1e-6):
+    """The inverse-distance rule: weight ``1 / ((d_j / d_min)^p + eps)``, ``k`` largest kept.
+
+    Parameters
+    ----------
+    dist : (N, J) float64
+        Distance of each point to each joint (overwritten: divided by each row's minimum).
+    k : int
+    power, eps : float
+        As in :func:`idw_weights`.
+
+    Returns
+    -------
+    indices : (N, k) int32
+        Columns of ``dist``.
+    weights : (N, k) float64, rows sum to 1
+    """
+    dist /= np.maximum(dist.min(axis=1, keepdims=True), 1e-12)
+    d2 = dist * dist
+    w = 1.0 / (d2 ** (power / 2.0) + eps) if power != 4 else 1.0 / (np.square(d2) + eps)
+    return top_k_influences(w, k)
 
 
 def idw_weights(vertices, skeleton, max_influences=4, power=4.0, eps=1e-6, chunk=4096,
@@ -84,10 +108,7 @@ def idw_weights(vertices, skeleton, max_influences=4, power=4.0, eps=1e-6, chunk
         d = np.full((len(d_seg), len(joints)), np.inf)
         for s, c in enumerate(col_of):  # a joint with several child bones: nearest one
             np.minimum(d[:, c], d_seg[:, s], out=d[:, c])
-        d_min = np.maximum(d.min(axis=1, keepdims=True), 1e-12)
-        d /= d_min
-        w = 1.0 / ((d * d) ** (power / 2.0) + eps) if power != 4 else 1.0 / (np.square(d * d) + eps)
-        idx, val = top_k_influences(w, k)
+        idx, val = inverse_distance_weights(d, k, power, eps)
         out_idx[lo:lo + chunk] = joints[idx]
         out_w[lo:lo + chunk] = val
         if progress is not None:
