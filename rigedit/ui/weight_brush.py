@@ -22,6 +22,7 @@ from PyQt5 import QtWidgets
 
 from ..model.weight_paint import (brush_vertices, joint_column, mirror_vertices, paint,
                                   paint_mirrored, vertex_adjacency)
+from ..render.observers import add_mouse_observers
 from ..render.ray import display_to_world, world_to_display
 from .brush_panel import BrushPanel
 
@@ -42,6 +43,8 @@ class WeightBrush:
         Joints whose weights painting must not change.
     stroke : dict or None
         The stroke under way: working ``indices`` and ``weights`` (V, K) and the ``joint``.
+    errors : list of str
+        Tracebacks of exceptions raised in the mouse callbacks (each also shown).
     """
 
     PRIORITY = 9.0  # below the axis handles (10), above the joint spheres (0.5) and camera
@@ -57,10 +60,11 @@ class WeightBrush:
         self._build_circle()
         iren = window.plotter.iren.interactor
         self._iren = iren
-        self._observers = [iren.AddObserver(event, self._guard(fn), self.PRIORITY)
-                           for event, fn in (("LeftButtonPressEvent", self._press),
-                                             ("MouseMoveEvent", self._move),
-                                             ("LeftButtonReleaseEvent", self._release))]
+        self.errors = []  # tracebacks of failed callbacks (see :meth:`on_error`)
+        self._observers = add_mouse_observers(
+            iren, {"LeftButtonPressEvent": self._press, "MouseMoveEvent": self._move,
+                   "LeftButtonReleaseEvent": self._release},
+            self.PRIORITY, self, "weight brush")
         tag = iren.AddObserver("LeftButtonReleaseEvent", self._click_release, self.PRIORITY)
         iren.GetCommand(tag).SetPassiveObserver(1)
         self._passive = [tag, iren.AddObserver("LeaveEvent", self._leave)]
@@ -141,17 +145,11 @@ class WeightBrush:
         self.panel.show_lock(d.selection in self.locked, names)
 
     # ------------------------------------------------------------------ events
-    def _guard(self, fn):
-        def callback(obj, event):
-            try:
-                if fn(obj):
-                    obj.GetCommand(self._observers[self._EVENTS.index(event)]).SetAbortFlag(1)
-            except Exception:  # noqa: BLE001 - VTK would swallow it; show it
-                self.cancel()
-                self.w.report_exception("Weight brush")
-        return callback
-
-    _EVENTS = ("LeftButtonPressEvent", "MouseMoveEvent", "LeftButtonReleaseEvent")
+    def on_error(self, _what):
+        """A mouse callback failed (called by :func:`.observers.record_failure` inside its
+        ``except``): the stroke is dropped and the error shown."""
+        self.cancel()
+        self.w.report_exception("Weight brush")
 
     def _active(self):
         return self.enabled and self.w.weights_view and self.w.scene.has_mesh
