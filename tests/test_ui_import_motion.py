@@ -14,7 +14,7 @@ from PyQt5 import QtWidgets  # noqa: E402
 import rigedit  # noqa: E402
 from rigedit.rigging.calibrate import model_stack  # noqa: E402
 
-from ui_window_fixture import editor_window, menu_action  # noqa: E402
+from ui_window_fixture import menu_action  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 WALK = DATA / "bvh-bandai" / "dataset-1_walk_normal_002.bvh"
@@ -54,12 +54,6 @@ def _import(w, qtbot, monkeypatch, path, add=True):
 
 def _state(doc):
     return {name: (clip, clip.name) for name, clip in doc.clips.items()}, doc.current_clip
-
-
-@pytest.fixture
-def humanoid_window(qtbot):
-    with editor_window(qtbot, rigedit.load_rig("humanoid")) as w:
-        yield w
 
 
 def test_import_bandai_walk_adds_one_moving_clip_as_one_undo_step(humanoid_window, qtbot,

@@ -20,7 +20,7 @@ from rigedit.rigging import load_map, retarget_result  # noqa: E402
 from rigedit.rigging.calibrate import model_stack  # noqa: E402
 from rigedit.ui.joint_map_dialog import NONE  # noqa: E402
 
-from ui_window_fixture import editor_window, menu_action  # noqa: E402
+from ui_window_fixture import menu_action  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 WALK = DATA / "bvh-bandai" / "dataset-1_walk_normal_002.bvh"
@@ -32,12 +32,6 @@ def motion():
     if WALK.exists():
         return WALK
     pytest.skip(f"shared test data not found: {WALK}")
-
-
-@pytest.fixture
-def humanoid_window(qtbot):
-    with editor_window(qtbot, rigedit.load_rig("humanoid")) as w:
-        yield w
 
 
 def _patch_dialog(monkeypatch, name, answer):

@@ -65,6 +65,13 @@ def demo_window(qtbot):
         yield w
 
 
+@pytest.fixture
+def humanoid_window(qtbot):
+    """The main window on a freshly loaded bundled humanoid (tests may change it)."""
+    with editor_window(qtbot, rigedit.load_rig("humanoid")) as w:
+        yield w
+
+
 def menu_action(window, menu, text):
     """The action ``text`` (without '&' and '...') of the window's menu ``menu``."""
     def clean(t):
