@@ -126,6 +126,14 @@ def write_skin(mesh, points, normals=None):
     mesh.Modified()
 
 
+def _bind_normals(proxy, rest_normals):
+    """Give ``proxy``'s binding its vertices' rest normals: the full mesh's ``rest_normals``
+    (V, 3) of their source vertices, returned (P, 3) float64."""
+    normals = np.asarray(rest_normals, dtype=np.float64)[proxy.source]
+    proxy.binding.bind_normals(normals)
+    return normals
+
+
 class ProxyActor:
     """A :class:`SkinProxy` drawn in a plotter: hidden until :meth:`set_visible`, sharing the
     full mesh actor's property (colour, display mode) and texture; its normals are skinned
@@ -150,8 +158,7 @@ class ProxyActor:
         self.proxy = proxy
         faces = np.hstack([np.full((len(proxy.faces), 1), 3), proxy.faces]).ravel()
         mesh = pv.PolyData(proxy.vertices.astype(np.float32), faces)
-        rest_normals = np.asarray(rest_normals, dtype=np.float64)[proxy.source]
-        proxy.binding.bind_normals(rest_normals)
+        rest_normals = _bind_normals(proxy, rest_normals)
         mesh.point_data.set_array(rest_normals.astype(np.float32), "Normals")
         mesh.point_data.active_normals_name = "Normals"
         if tcoords is not None:
@@ -163,6 +170,13 @@ class ProxyActor:
         if texture is not None:
             self.actor.SetTexture(texture)
         self.actor.SetVisibility(False)
+
+    def rebind(self, proxy, rest_normals):
+        """Draw ``proxy``, this one's geometry re-bound (:meth:`SkinProxy.rebind`), in the
+        same actor; ``rest_normals`` as in the constructor. Skinned by the next
+        :meth:`skin`."""
+        _bind_normals(proxy, rest_normals)
+        self.proxy = proxy
 
     def set_visible(self, on):
         self.actor.SetVisibility(bool(on))

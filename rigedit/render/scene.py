@@ -349,12 +349,18 @@ class RigScene:
     # ------------------------------------------------------------------ proxy
     def attach_proxy(self, proxy):
         """Draw ``proxy`` (a :class:`~rigedit.render.proxy.SkinProxy` of this rig's mesh)
-        instead of the mesh while :meth:`show_proxy` says so."""
-        self.detach_proxy()
-        tcoords = self.mesh.active_texture_coordinates if self._texture is not None else None
+        instead of the mesh while :meth:`show_proxy` says so. The same proxy re-bound
+        (:meth:`SkinProxy.rebind`, after a rest move) keeps its actor."""
+        self.show_proxy(False)
         self._bind_rest_normals()
-        self.proxy_actor = ProxyActor(self.plotter, proxy, self.mesh_actor,
-                                      self._rest_normals, self._texture, tcoords)
+        if self.proxy is not None and proxy.faces is self.proxy.faces:
+            self.proxy_actor.rebind(proxy, self._rest_normals)
+        else:
+            self.detach_proxy()
+            tcoords = self.mesh.active_texture_coordinates if self._texture is not None \
+                else None
+            self.proxy_actor = ProxyActor(self.plotter, proxy, self.mesh_actor,
+                                          self._rest_normals, self._texture, tcoords)
         self.proxy = proxy
 
     def detach_proxy(self):
