@@ -12,7 +12,6 @@ import argparse
 import os
 import sys
 import time
-import warnings
 from pathlib import Path
 
 __all__ = ["main", "build_parser"]
@@ -27,12 +26,10 @@ class UsageError(Exception):
 def _load(rig_arg, method=None, scale=None):
     import rigedit
 
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        rig = rigedit.load_rig(rig_arg, weights_method=method, scale=scale)
-    for w in caught:  # computed weights, skipped joints: worth a line, not a traceback
-        print(f"rigedit: warning: {w.message}", file=sys.stderr)
-    return rig
+    from .cli_output import warning_lines
+
+    with warning_lines():
+        return rigedit.load_rig(rig_arg, weights_method=method, scale=scale)
 
 
 def cmd_info(args):
@@ -62,6 +59,7 @@ def cmd_list(args):
 
 
 def cmd_weights(args):
+    from .cli_output import warning_lines
     from .io.weights_npz import save_weights
     from .model.weights import compute_weights, default_method
 
@@ -70,14 +68,11 @@ def cmd_weights(args):
     rig = _load(args.rig, scale=args.scale)
     t0 = time.perf_counter()
     method = args.method or default_method(rig.faces)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with warning_lines():
         res = compute_weights(rig.vertices, rig.skeleton, method, args.max_influences,
                               faces=rig.faces)
+        dt = time.perf_counter() - t0
     idx, w = res
-    dt = time.perf_counter() - t0
-    for warning in caught:  # heat's fallback and skeleton notes: a line each
-        print(f"rigedit: warning: {warning.message}", file=sys.stderr)
     fallback = getattr(res, "fallback", None)
     save_weights(args.output, idx, w, rig.skeleton.names)
     print(f"wrote {args.output}: {len(idx)} vertices, {idx.shape[1]} influences, "

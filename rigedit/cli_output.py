@@ -15,13 +15,16 @@ from __future__ import annotations
 
 import contextlib
 import signal
+import sys
 import threading
+import warnings
 from pathlib import Path
 
 from .errors import RigFileError
 from .io.atomic import check_output_folder
 
-__all__ = ["Interrupted", "interruptible", "check_interrupted", "deferred", "check_output"]
+__all__ = ["Interrupted", "interruptible", "check_interrupted", "deferred", "check_output",
+           "warning_lines"]
 
 #: Signals received within :func:`interruptible`, oldest first.
 _received = []
@@ -83,6 +86,18 @@ def interruptible():
         for sig, handler in previous.items():
             signal.signal(sig, handler)
         _received.clear()
+
+
+@contextlib.contextmanager
+def warning_lines():
+    """Warnings raised within the block (computed weights, skipped joints, heat's fallback)
+    are collected and printed when it ends, each as one line ``rigedit: warning: ...`` on
+    stderr: worth a line, not a traceback. Not printed when the block raises."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield
+    for w in caught:
+        print(f"rigedit: warning: {w.message}", file=sys.stderr)
 
 
 def check_output(path, folder_ok=False):
