@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.transforms import tangents
+
 __all__ = ["centre_joints"]
 
 
@@ -38,9 +40,7 @@ def centre_joints(field, points, directions, reach=1.5):
         if depth[i] <= 0 or not np.isfinite(length) or length < 1e-12:
             continue
         d = directions[i] / length
-        e1 = np.cross(d, [1.0, 0, 0] if abs(d[0]) < 0.9 else [0, 1.0, 0])
-        e1 /= np.linalg.norm(e1)
-        e2 = np.cross(d, e1)
+        e1, e2 = tangents(d)
         radius = reach * depth[i] + 2 * h
         t = np.arange(-radius, radius + 1e-12, 0.5 * h)
         u, v = np.meshgrid(t, t)

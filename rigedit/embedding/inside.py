@@ -17,6 +17,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
+from ..model.transforms import tangents
 from .distance import surface_samples
 
 __all__ = ["keep_inside", "describe_joints", "TOLERANCE", "SHORTEST", "COLLAPSED"]
@@ -84,9 +85,7 @@ def _turns(direction):
     """Rotations to try on a branch pointing along ``direction`` (3,): none first, then
     ``TURNS`` degrees about 8 axes perpendicular to it, least first."""
     d = direction / max(np.linalg.norm(direction), 1e-300)
-    u = np.cross(d, [1.0, 0, 0] if abs(d[0]) < 0.9 else [0, 1.0, 0])
-    u /= np.linalg.norm(u)
-    v = np.cross(d, u)
+    u, v = tangents(d)
     out = [Rotation.identity()]
     for angle in np.radians(TURNS):
         for phi in np.linspace(0, 2 * np.pi, 8, endpoint=False):

@@ -9,7 +9,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 __all__ = ["compose_trs", "decompose_trs", "euler_to_quat", "quat_to_euler",
-           "translation_matrix", "normalize_quats", "quat_multiply"]
+           "translation_matrix", "normalize_quats", "quat_multiply", "tangents"]
 
 
 def compose_trs(translation, rotation, scale=None):
@@ -122,3 +122,12 @@ def quat_multiply(a, b):
                      aw * by - ax * bz + ay * bw + az * bx,
                      aw * bz + ax * by - ay * bx + az * bw,
                      aw * bw - ax * bx - ay * by - az * bz], axis=-1)
+
+
+def tangents(c):
+    """Two unit vectors (3,) spanning the plane normal to the unit vector ``c`` (3,);
+    ``c``, ``e1``, ``e2`` are right-handed."""
+    c = np.asarray(c, dtype=np.float64)
+    e1 = np.cross(c, [1.0, 0, 0] if abs(c[0]) < 0.9 else [0, 1.0, 0])
+    e1 = e1 / np.linalg.norm(e1)
+    return e1, np.cross(c, e1)

@@ -1,28 +1,22 @@
 """Where a character stands: the support line its feet touch, in its mirror plane.
 
 Used by :mod:`.orient` to level the ground under an upright figure and to find which way a
-long body (a quadruped) stands, all round, and by :mod:`.mirror`; the small plane helpers
-(:func:`tangents`, :func:`angle`) live here.
+long body (a quadruped) stands, all round.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ..model.transforms import tangents
 from .calibrate import unit
 
-__all__ = ["support_up", "stands_on", "find_ground", "tangents", "angle"]
+__all__ = ["support_up", "stands_on", "find_ground", "angle"]
 
 GROUND_DEGREES = 20.0
 GROUND_TOUCH = 0.005
 GROUND_SPAN = 0.2
 GROUND_LEAD = 1.5
 FOOT_APART = 0.03
-
-
-def tangents(c):
-    """Two unit vectors (3,) spanning the plane normal to the unit vector ``c``."""
-    e1 = unit(np.cross(c, [1.0, 0, 0] if abs(c[0]) < 0.9 else [0, 1.0, 0]))
-    return e1, np.cross(c, e1)
 
 
 def angle(a, b):

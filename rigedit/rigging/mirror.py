@@ -8,8 +8,8 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.spatial import cKDTree
 
+from ..model.transforms import tangents
 from .calibrate import unit
-from .ground import tangents
 
 __all__ = ["symmetry_plane", "surface_samples", "volume_centroid", "SAMPLES"]
 

@@ -44,8 +44,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model.transforms import tangents
 from .calibrate import unit
-from .ground import angle, find_ground, support_up, tangents
+from .ground import angle, find_ground, support_up
 from .mirror import surface_samples, symmetry_plane, volume_centroid
 
 __all__ = ["Orientation", "orient", "check_axes", "parse_axis", "axis_name", "SNAP_DEGREES"]
