@@ -137,17 +137,18 @@ def _read_meshio(path):
         _check_ply_header(path, path.stat().st_size)
 
     m = third_party_read(path, lambda: meshio.read(path))
-    polys = []
+    polys, in_range = [], True
     for block in m.cells:
         if block.type in ("triangle", "quad", "polygon"):
             data = np.asarray(block.data)
             if data.dtype.kind not in "iu":
                 raise RigFileError(path, f"expected integer face indices, got {data.dtype}")
+            in_range &= not data.size or (data.min() >= 0 and data.max() <= MAX_INDEX)
             polys.extend(data.tolist())
     points = np.asarray(m.points)
     if points.ndim != 2 or points.shape[1] < 3 or points.dtype.kind not in "iuf":
         raise RigFileError(path, f"expected 3D points, got an array of shape {points.shape}")
-    if any(i < 0 or i > MAX_INDEX for p in polys for i in (min(p, default=0), max(p, default=0))):
+    if not in_range:
         raise RigFileError(path, f"expected face indices from 0 to {MAX_INDEX}")
     return points[:, :3].astype(np.float64), triangulate(polys)
 
