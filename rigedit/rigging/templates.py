@@ -88,7 +88,7 @@ def template_poses(skeleton, rig, what):
 
     if rig is None or len(rig.vertices) or not rig.clips:
         return [(skeleton, "rest")]
-    poses = [("rest", skeleton.forward(skeleton.rest_local_matrices()))]
+    poses = [("rest", rest_model(skeleton))]
     for name in sorted(rig.clips):
         poses.append((f"frame 0 of {name}",
                       skeleton.forward(rig.clips[name].sample(0.0).local_matrices())))
