@@ -6,7 +6,7 @@ import numpy as np
 from .name_map import find_slots
 
 __all__ = ["Calibration", "calibrate", "model_stack", "swing", "unit", "rotations_of",
-           "foot_points", "HUMANOID_GROUPS"]
+           "foot_points", "tail_point", "HUMANOID_GROUPS"]
 
 #: Groups of bones reported by :func:`rigedit.rigging.measure.direction_errors` for humanoids:
 #: "feet" (foot and toe bones) apart, as their pitch is transferred relative to each figure's
@@ -159,15 +159,21 @@ class Calibration:
         return "head" if slot in ("neck", "head") else "spine"
 
 
+def tail_point(skeleton, mats, j):
+    """(F, 3) model position of joint ``j``'s tail in the poses ``mats`` (F, J, 4, 4), or
+    None when it has none."""
+    if not np.all(np.isfinite(skeleton.tails[j])):
+        return None
+    local = skeleton.inverse_bind_matrices[j] @ np.r_[skeleton.tails[j], 1.0]
+    return (mats[:, j] @ local)[:, :3]
+
+
 def foot_points(skeleton, feet, mats):
     """(F, P, 3) model positions of the joints ``feet`` and of their tails, in the poses
     ``mats`` (F, J, 4, 4)."""
-    pts = [mats[:, j, :3, 3] for j in feet]
-    for j in feet:
-        if np.all(np.isfinite(skeleton.tails[j])):
-            local = skeleton.inverse_bind_matrices[j] @ np.r_[skeleton.tails[j], 1.0]
-            pts.append((mats[:, j] @ local)[:, :3])
-    return np.stack(pts, axis=1)
+    tails = [tail_point(skeleton, mats, j) for j in feet]
+    return np.stack([mats[:, j, :3, 3] for j in feet] + [t for t in tails if t is not None],
+                    axis=1)
 
 
 def calibrate(skeleton, clips, what, kind=Calibration):

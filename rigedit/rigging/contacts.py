@@ -16,10 +16,9 @@ import numpy as np
 
 from scipy.spatial.transform import Rotation
 
-from .calibrate import foot_points, rotations_of, swing, unit
+from .calibrate import foot_points, rotations_of, swing, tail_point, unit
 
 __all__ = ["detect_contacts", "runs", "pin_offsets", "two_bone_ik", "clean_feet", "clean_legs",
-           "tail_point",
            "HEIGHT_TOL", "SPEED_TOL"]
 
 HEIGHT_TOL = 0.06
@@ -280,11 +279,3 @@ def _smooth_max(x, width):
     peak = windows.max(axis=1)
     kernel = np.ones(2 * width + 1) / (2 * width + 1)
     return np.maximum(np.convolve(np.pad(peak, width, mode="edge"), kernel, mode="valid"), x)
-
-
-def tail_point(skeleton, mats, j):
-    """(F, 3) model position of joint ``j``'s tail, or None when it has none."""
-    if not np.all(np.isfinite(skeleton.tails[j])):
-        return None
-    local = skeleton.inverse_bind_matrices[j] @ np.r_[skeleton.tails[j], 1.0]
-    return (mats[:, j] @ local)[:, :3]

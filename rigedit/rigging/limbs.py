@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .calibrate import foot_points, unit
+from .calibrate import foot_points, tail_point, unit
 from .name_map import _KNEE, bend_index
 
 __all__ = ["Leg", "find_legs", "LegCalibration", "leg_contacts", "ground", "motion_ground",
@@ -50,7 +50,7 @@ def tail_points(skeleton, mats):
     joint has none."""
     out = np.full((len(skeleton), 3), np.nan)
     for j in np.flatnonzero(np.all(np.isfinite(skeleton.tails), axis=1)):
-        out[j] = (mats[j] @ (skeleton.inverse_bind_matrices[j] @ np.r_[skeleton.tails[j], 1]))[:3]
+        out[j] = tail_point(skeleton, mats[None], j)[0]
     return out
 
 
