@@ -19,6 +19,8 @@ import numpy as np
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
+from ..model.laplacian import face_areas
+
 __all__ = ["DistanceField", "distance_field", "surface_samples"]
 
 #: Cells along the longest side of the mesh's bounding box. 128 keeps a limb 4 cm thick on a
@@ -86,7 +88,7 @@ class DistanceField:
 def surface_samples(vertices, faces, spacing, rng):
     """Vertices plus random points on faces, about ``spacing`` apart, (S, 3) float64."""
     tri = vertices[faces]
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    area = face_areas(vertices, faces)
     count = np.ceil(area / (spacing * spacing)).astype(np.int64)
     count[area <= 0] = 0
     which = np.repeat(np.arange(len(faces)), count)

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model.laplacian import face_areas
 from .distance import distance_field
 from .fit import W_SCALE_FIRM, W_SCALE_WEAK, fit_joints
 from .graph import medial_graph
@@ -93,7 +94,7 @@ def _check_mesh(vertices, faces):
 def _frame(vertices, faces):
     """Floor, height and middle plane (area-weighted centroid x) of the mesh."""
     tri = vertices[faces]
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    area = face_areas(vertices, faces)
     centre = tri.mean(axis=1)
     plane = float(np.average(centre[:, 0], weights=area)) if area.sum() > 0 else float(
         vertices[:, 0].mean())

@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.laplacian import face_areas
+
 __all__ = ["ReducedTemplate", "reduce_template", "SHORT", "REQUIRED"]
 
 SHORT = 0.1
@@ -193,9 +195,7 @@ def reduce_template(skeleton, mesh=None):
 
 def surface_area(vertices, faces):
     """Total area of a triangle mesh."""
-    tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces, dtype=np.int64)]
-    return float(0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
-                                      axis=1).sum())
+    return float(face_areas(vertices, faces).sum())
 
 
 def _optional(parent, length):

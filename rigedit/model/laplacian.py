@@ -16,7 +16,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 __all__ = ["weld", "clean_faces", "cotangent_laplacian", "components", "vertex_normals",
-           "COT_MAX"]
+           "face_areas", "COT_MAX"]
 
 # cot(1 degree) ~ 57: angles below one degree are treated as one degree.
 COT_MAX = 1.0 / np.tan(np.radians(1.0))
@@ -73,6 +73,12 @@ def clean_faces(faces):
         _, keep = np.unique(np.sort(f, axis=1), axis=0, return_index=True)
         f = f[np.sort(keep)]
     return f
+
+
+def face_areas(vertices, faces):
+    """(F,) float64 areas of the triangles ``faces`` (F, 3) of ``vertices`` (V, 3)."""
+    tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces, dtype=np.int64)]
+    return 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
 
 
 def cotangent_laplacian(vertices, faces):

@@ -190,8 +190,7 @@ def check_mesh(vertices, faces, path="mesh"):
     diag = max(float(np.linalg.norm(np.ptp(vertices, axis=0))), 1e-12)
     rep, wv = lap.weld(vertices, WELD * diag)
     wf = lap.clean_faces(rep[faces])
-    tri = wv[wf]
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    area = lap.face_areas(wv, wf)
     keep = area > 0
     wf, area = wf[keep], area[keep]
     if len(wf) == 0:

@@ -8,6 +8,7 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.spatial import cKDTree
 
+from ..model.laplacian import face_areas
 from ..model.transforms import tangents
 from .calibrate import unit
 
@@ -19,7 +20,7 @@ SAMPLES = 4000
 def surface_samples(vertices, faces, n=SAMPLES, seed=0):
     """(n, 3) points spread uniformly over the surface (area-weighted, deterministic)."""
     tri = vertices[faces]
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    area = face_areas(vertices, faces)
     rng = np.random.default_rng(seed)
     pick = rng.choice(len(faces), size=n, p=area / area.sum())
     r1, r2 = rng.random(n), rng.random(n)
