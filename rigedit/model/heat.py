@@ -33,7 +33,7 @@ import scipy.sparse as sp
 
 from . import laplacian as lap
 from .skinning import top_k_influences
-from .tails import bone_segments_with_tails, deforming_joints, infer_leaf_tails
+from .tails import deforming_joints, infer_leaf_tails
 from .visibility import SurfaceRays
 from .weights import inverse_distance_weights, point_segment_distance
 
@@ -111,7 +111,7 @@ def _joint_distances(points, starts, ends, owners, joints, dist=None, seg=None,
                      seg_index=None):
     """Distance of each point to each joint (nearest of its segments) and that segment.
 
-    Segments must be grouped by owner (as :func:`bone_segments_with_tails` returns them).
+    Segments must be grouped by owner (as :meth:`Skeleton.bone_segments` returns them).
     With ``dist`` and ``seg`` given, only the columns of the joints in ``owners`` are
     recomputed, in place; ``seg_index`` maps these segments to their global indices.
 
@@ -251,12 +251,12 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
     normals = lap.vertex_normals(wv, wf, label)
     deform = deforming_joints(skeleton, wv, normals)
     tails = skeleton.tails
-    starts, ends, owners = bone_segments_with_tails(skeleton, deform, skeleton.tails)
+    starts, ends, owners = skeleton.bone_segments(deform=deform)
     joints = np.unique(owners)
     dist, seg = _joint_distances(wv, starts, ends, owners, joints)
     if infer_tails:
         tails = infer_leaf_tails(skeleton, deform, wv, joints[dist.argmin(axis=1)], rays)
-        starts, ends, owners = bone_segments_with_tails(skeleton, deform, tails)
+        starts, ends, owners = skeleton.bone_segments(deform=deform, tails=tails)
         changed = np.isin(owners, np.flatnonzero(np.isfinite(tails[:, 0])
                                                  & ~np.isfinite(skeleton.tails[:, 0])))
         if changed.any():  # only the leaves that got a tail

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 
-__all__ = ["deforming_joints", "bone_segments_with_tails", "infer_leaf_tails"]
+__all__ = ["deforming_joints", "infer_leaf_tails"]
 
 REACH = 0.8
 MIN_REGION = 3
@@ -77,26 +77,6 @@ def _inside_fraction(points, vertices, normals):
     d2 = (np.einsum("vd,vd->v", vertices, vertices)[None, :] - 2.0 * points @ vertices.T)
     near = d2.argmin(axis=1)
     return float(np.mean(np.einsum("ij,ij->i", points - vertices[near], normals[near]) < 0))
-
-
-def bone_segments_with_tails(skeleton, deform, tails):
-    """Segments of the deforming joints, with given tails for leaves
-    (:meth:`Skeleton.bone_segments` with ``deform`` and ``tails`` given).
-
-    Parameters
-    ----------
-    skeleton : Skeleton
-    deform : (J,) bool
-    tails : (J, 3) float64
-        Model-space tails; NaN rows where a joint has none (a non-leaf then runs to each
-        child, a leaf is a point).
-
-    Returns
-    -------
-    starts, ends : (S, 3) float64
-    owners : (S,) int64
-    """
-    return skeleton.bone_segments(deform=deform, tails=tails)
 
 
 def infer_leaf_tails(skeleton, deform, vertices, nearest_owner, rays=None):
