@@ -29,6 +29,7 @@ conventionally Y up, rigedit's own convention, so axes are kept as they are
 from __future__ import annotations
 
 import warnings
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -246,11 +247,8 @@ def load_bvh(path, scale=None):
     orders = {name: "".join("XYZ"[axis] for kind, axis in channels if kind == "rotation")
               for name, channels in zip(names, data["channels"])}
     rig.source_rotation_orders = {n: o for n, o in orders.items() if sorted(o) == list("XYZ")}
-    counts = {}
-    for o in rig.source_rotation_orders.values():
-        counts[o] = counts.get(o, 0) + 1
-    rig.notes["rotation_order"] = ", ".join(f"{o} ({n} joints)" for o, n in
-                                            sorted(counts.items(), key=lambda c: -c[1])) or "-"
+    counts = Counter(rig.source_rotation_orders.values()).most_common()
+    rig.notes["rotation_order"] = ", ".join(f"{o} ({n} joints)" for o, n in counts) or "-"
     return rig
 
 
