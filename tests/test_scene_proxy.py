@@ -139,3 +139,30 @@ def test_a_small_mesh_has_no_proxy(qtbot, quadruped):
         assert not w.scene.proxy_shown
     finally:
         w.close()
+
+
+def test_a_rebound_proxy_keeps_its_actor_and_skins_with_the_new_influences(big):
+    from rigedit.model.skinning import SkinBinding
+
+    plotter = pv.Plotter(off_screen=True, window_size=(320, 240))
+    try:
+        scene = RigScene(plotter, big, show_floor=False)
+        proxy = build_proxy(big.binding, big.faces, target_faces=30_000)
+        scene.attach_proxy(proxy)
+        actor = scene.proxy_actor.actor
+        # a re-bind after a rest move: the same proxy geometry, other influences (here every
+        # vertex on the neck, so a walk pose moves it rigidly with that joint)
+        b = big.binding
+        neck = big.skeleton.joint_index("neck_1")
+        rebound = SkinBinding(big.vertices, np.full_like(b.indices, neck), b.weights,
+                              b.num_joints)
+        scene.attach_proxy(proxy.rebind(rebound))
+        assert scene.proxy_actor.actor is actor and plotter.actors["rig-proxy"] is actor
+        assert scene.show_proxy(True)
+        pose = walk_pose(big)
+        scene.update(pose)
+        palette = skinning_matrices(big.skeleton, big.joint_matrices(pose))
+        expected = proxy.vertices @ palette[neck, :3, :3].T + palette[neck, :3, 3]
+        np.testing.assert_allclose(scene.proxy_actor.mesh.points, expected, atol=1e-5)
+    finally:
+        plotter.close()
