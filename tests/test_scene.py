@@ -11,14 +11,14 @@ vtk = pytest.importorskip("vtk")
 from rigedit.render.scene import RigScene  # noqa: E402
 
 SIZE = (640, 400)
-BACKGROUND = ("#3a3f47", "#1d2026")  # the editor's
+BACKGROUND = "#2b2f36"  # the editor's
 
 
 @pytest.fixture
 def plotter():
     p = pv.Plotter(off_screen=True, window_size=SIZE)
     p.disable_anti_aliasing()
-    p.set_background(BACKGROUND[0], top=BACKGROUND[1])
+    p.set_background(BACKGROUND)
     p.enable_lightkit()
     yield p
     p.close()
@@ -167,6 +167,24 @@ def test_the_recorder_floor_is_its_grid_lines_alone(plotter, quadruped):
     RigScene(plotter, quadruped, floor_style="lines")
     assert "rig-floor" not in plotter.actors
     grid = plotter.actors["rig-grid"]
-    assert grid.GetMapper().GetInput().GetNumberOfLines() == 2 * 40 * 41
+    lines = pv.wrap(grid.GetMapper().GetInput())
+    # 41 lines each way from edge to edge, not the 3,280 edges of the 40 x 40 cells
+    assert lines.n_lines == 2 * 41
+    ends = lines.points.reshape(-1, 2, 3)
+    lengths = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
+    np.testing.assert_allclose(lengths, lengths[0])
+    # ... drawing the same pixels as those cell edges
+    before = shot(plotter)
+    grid.SetVisibility(False)
+    plane = pv.Plane(center=lines.center, direction=(0, 1, 0), i_size=lengths[0],
+                     j_size=lengths[0], i_resolution=40, j_resolution=40)
+    plotter.add_mesh(plane.extract_all_edges(), color=grid.GetProperty().GetColor(),
+                     lighting=True, reset_camera=False)
+    edges = shot(plotter)
+    plotter.actors[list(plotter.actors)[-1]].SetVisibility(False)
+    grid_pixels = np.abs(before - shot(plotter)).max(axis=2) > 8
+    assert grid_pixels.mean() > 0.02            # the grid is in view
+    differ = np.abs(before - edges).max(axis=2) > 8
+    assert differ.mean() < 0.05 * grid_pixels.mean(), (differ.mean(), grid_pixels.mean())
     with pytest.raises(ValueError, match="floor style"):
         RigScene(plotter, quadruped, floor_style="tiles")

@@ -72,6 +72,54 @@ def test_one_shot_playback_stops_at_the_end(window, qtbot):
     assert tl.time == pytest.approx(1.0)
 
 
+def test_joint_panel_refreshes_less_often_while_playing_and_shows_the_paused_pose(
+        window, qtbot):
+    from rigedit.ui.main_window import PANEL_PLAYBACK_MS
+
+    d, tl, panel = window.document, window.timeline, window.joint_panel
+    d.select(d.skeleton.index["neck"])
+    shown = []
+    original = panel.show_joint
+    panel.show_joint = lambda j, pose: (shown.append(tl.time), original(j, pose))
+    tl.play()
+    tl.timer.stop()            # frames stepped by hand, each drawn
+    start = time.perf_counter()
+    for i in range(50):
+        tl.set_time(0.01 * i)
+        QtWidgets.QApplication.processEvents()
+    elapsed = time.perf_counter() - start
+    # at most one refresh per PANEL_PLAYBACK_MS (the frames came faster than that)
+    assert elapsed < 50 * PANEL_PLAYBACK_MS / 1e3 / 2
+    assert len(shown) <= elapsed / (PANEL_PLAYBACK_MS / 1e3) + 1
+    tl.pause()
+    qtbot.wait(PANEL_PLAYBACK_MS + 50)
+    # the panel came back to the pose on screen: the nod's angle at the last frame
+    assert shown and shown[-1] == pytest.approx(0.49)
+    np.testing.assert_allclose(panel.angles(), d.pose.get_euler(d.selection, degrees=True),
+                               atol=0.05)
+    # paused: every pose change shows at once again
+    tl.set_time(0.25)
+    assert shown[-1] == pytest.approx(0.25)
+
+
+def test_ruler_cursor_repaint_matches_a_whole_repaint(window, qtbot):
+    ruler = window.timeline.ruler
+    window.timeline.set_time(0.2)
+    ruler.repaint()
+    window.timeline.set_time(0.7)       # only the time changed: two cursor strips repainted
+    ruler.repaint(ruler._cursor_rect(ruler.x_of(0.2)))
+    ruler.repaint(ruler._cursor_rect(ruler.x_of(0.7)))
+    strips = ruler.grab().toImage()
+    ruler._background = None            # forget the cached picture: paint everything
+    ruler.repaint()
+    whole = ruler.grab().toImage()
+    assert strips == whole
+    # and the cursor did move: the picture at 0.2 differs
+    window.timeline.set_time(0.2)
+    ruler.repaint()
+    assert ruler.grab().toImage() != whole
+
+
 def test_scrubbing_with_the_mouse_poses_the_mesh(window, qtbot):
     tl, ruler = window.timeline, window.timeline.ruler
     before = np.array(window.scene.mesh.points)

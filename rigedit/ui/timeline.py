@@ -104,7 +104,11 @@ class TimelineDock(QtWidgets.QDockWidget):
         self.duration_spin.setKeyboardTracking(False)
         self.duration_spin.valueChanged.connect(self.set_duration)
         self.time_label = QtWidgets.QLabel()
-        self.time_label.setMinimumWidth(150)
+        # A fixed size: a label that may change size re-lays out the whole dock on every
+        # playback frame's setText
+        self.time_label.setText("9999.99 s   frame 99999.9")
+        self.time_label.setFixedSize(max(150, self.time_label.sizeHint().width() + 8),
+                                     self.time_label.sizeHint().height())
         for w in (self.stop_button, self.play_button, self.loop_box, QtWidgets.QLabel("Speed"),
                   self.speed_spin, self.fps_spin, QtWidgets.QLabel("  Clip"), self.clip_combo,
                   _button("New", "New empty clip", lambda: self.new_clip()),
