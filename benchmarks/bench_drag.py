@@ -14,8 +14,11 @@
    while the joint moves, the full mesh on release) and with the proxy turned off (the full
    mesh every frame); frames/s of each and what the status bar said.
 
+``--compare-ik OLD_IK.py`` times section 1 with another version's ``rigedit/model/ik.py`` too,
+interleaved with this tree's, and prints how far apart their solutions are.
+
 Run: ``xvfb-run -a .venv/bin/python benchmarks/bench_drag.py [RIG] [--size 1280x720]
-[--big]``.
+[--big] [--compare-ik OLD_IK.py]``.
 """
 from __future__ import annotations
 
@@ -49,8 +52,11 @@ def drag_targets(rig, steps):
     return j, start, targets
 
 
-def model_step(rig, steps=300):
-    from rigedit.model.ik import drag_joint
+def model_step(rig, steps=300, drag_joint=None):
+    """Median-ready times (ms) of the model side of a drag step (IK, FK, palette, skinning)
+    and of the IK alone, over ``steps`` targets, each from the pose at drag start."""
+    if drag_joint is None:
+        from rigedit.model.ik import drag_joint
 
     sk = rig.skeleton
     j, start, targets = drag_targets(rig, steps)
@@ -65,12 +71,62 @@ def model_step(rig, steps=300):
         rig.binding.skin(np.matmul(model, sk.inverse_bind_matrices))
         times.append(time.perf_counter() - t0)
     ik = []
-    for t in targets[:100]:
+    for t in targets:
         t0 = time.perf_counter()
         work.set_array(snap)
         drag_joint(sk, work, j, t, chain_length=2, fk=rig.joint_matrices)
         ik.append(time.perf_counter() - t0)
     return np.array(times) * 1e3, np.array(ik) * 1e3
+
+
+def load_ik(path):
+    """An ``ik.py`` of another version (``git show REV:rigedit/model/ik.py > old_ik.py``),
+    loaded as a module of ``rigedit.model`` so its relative imports resolve."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("rigedit.model._ik_compared", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def compare_model_step(rig, other_ik, rounds=5):
+    """Model drag step and IK alone, this tree's ``ik`` and ``other_ik`` interleaved over
+    ``rounds``; prints the median of each and the largest distance between the joint
+    positions the two solve for the same targets."""
+    from rigedit.model.ik import drag_joint
+
+    rows = {"this tree": ([], []), other_ik.__file__: ([], [])}
+    for _ in range(rounds):
+        for label, fn in (("this tree", drag_joint), (other_ik.__file__, other_ik.drag_joint)):
+            total, ik = model_step(rig, drag_joint=fn)
+            rows[label][0].append(np.median(total))
+            rows[label][1].append(np.median(ik))
+    for label, (total, ik) in rows.items():
+        print(f"  {label:<40} step median {np.median(total):.3f} ms (rounds "
+              f"{min(total):.3f}-{max(total):.3f}), IK alone {np.median(ik):.3f} ms "
+              f"({min(ik):.3f}-{max(ik):.3f})")
+    from rigedit.model.ik import ik_chain
+
+    j, start, targets = drag_targets(rig, 300)
+    sk = rig.skeleton
+    rest = rig.joint_matrices(start)[:, :3, 3]
+    path = ik_chain(sk, j, 2) + [j]
+    reach = np.linalg.norm(np.diff(rest[path], axis=0), axis=1).sum()
+    worst, misses = 0.0, {"this tree": 0.0, "other": 0.0}
+    for t in targets:
+        a, b = start.copy(), start.copy()
+        drag_joint(sk, a, j, t, chain_length=2, fk=rig.joint_matrices)
+        other_ik.drag_joint(sk, b, j, t, chain_length=2, fk=rig.joint_matrices)
+        pa, pb = rig.joint_matrices(a)[:, :3, 3], rig.joint_matrices(b)[:, :3, 3]
+        worst = max(worst, float(np.abs(pa - pb).max()))
+        if np.linalg.norm(t - rest[path[0]]) < reach:
+            misses["this tree"] = max(misses["this tree"], float(np.linalg.norm(pa[j] - t)))
+            misses["other"] = max(misses["other"], float(np.linalg.norm(pb[j] - t)))
+    print(f"  largest joint position difference between the two: {worst:.2e} "
+          f"(character height {rig.height():.3f}); largest distance from the dragged joint to "
+          f"a reachable target: this tree {misses['this tree']:.1e}, the other "
+          f"{misses['other']:.1e}")
 
 
 def big_rig(rig, levels=2):
@@ -153,6 +209,9 @@ def main():
     parser.add_argument("--big", action="store_true",
                         help="also drag the quadruped split to 540k triangles")
     parser.add_argument("--rounds", type=int, default=2, help="rounds of the --big drags")
+    parser.add_argument("--compare-ik", metavar="OLD_IK.py",
+                        help="also time the model step with another version's ik.py, "
+                             "interleaved with this tree's")
     args = parser.parse_args()
     import rigedit
     from rigedit.model import skinning_kernels
@@ -168,6 +227,9 @@ def main():
         total, ik = model_step(rig)
         print(f"model drag step (IK chain 2 + FK + skinning): median {np.median(total):.2f} ms, "
               f"p95 {np.percentile(total, 95):.2f} ms  (IK alone {np.median(ik):.2f} ms)")
+        if args.compare_ik:
+            print("model drag step, interleaved (median of 5 rounds of 300 steps):")
+            compare_model_step(rig, load_ik(args.compare_ik))
         if not args.no_window:
             size = tuple(int(v) for v in args.size.split("x"))
             fps, per_move, scene_ms, steps, _ = window_drag(rig, size)

@@ -1,86 +1,116 @@
-"""Inverse kinematics for dragging joints: aim a bone, FABRIK chains, chain selection.
+"""Inverse kinematics for dragging joints: two-bone closed form, FABRIK chains, aiming.
 
-Pure numpy + scipy. The editor calls :func:`drag_joint`, which picks what to move for a dragged
+The editor calls :func:`drag_joint` once per mouse move, which picks what to move for a dragged
 joint (a root translates, a joint with a parent rotates its chain) and writes the result into a
-:class:`Pose`.
+:class:`Pose`. Where the chain's points go comes from :mod:`.ik_points`: a chain of two rotated
+joints (three points: thigh, shin, foot) in closed form (:func:`two_bone`), longer chains with
+FABRIK (:func:`fabrik`). The solved positions are then turned back into local rotations one
+joint at a time from the top of the chain, each the smallest rotation that points the bone at
+its solved child position, so twist is kept.
 
-FABRIK (Aristidou & Lasenby 2011) solves on positions; the positions are then turned back into
-local rotations one joint at a time from the top of the chain (:func:`aim_joint`), each the
-smallest rotation that points the bone at its solved child position, so twist is kept. No kept
-library solves IK on our pose representation, hence this module.
+Why plain floats: a drag step rotates two to four joints. At that size SciPy's per-call overhead
+(a few microseconds for each ``Rotation`` object) is most of the cost, so the per-step
+quaternion arithmetic here is written on Python floats, and the chain's model matrices are
+carried down the chain from the parent's matrix and the new local rotation instead of
+recomputing the whole skeleton's forward kinematics after each joint. SciPy's ``Rotation``
+stays the public type of :func:`rotation_between`. No kept library solves IK on our pose
+representation, hence this module.
 """
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .ik_points import _TINY, _cross, _dot, _norm, _sub, _unit_or, fabrik, two_bone
 from .kinematics import local_to_model
 
-__all__ = ["fabrik", "aim_joint", "ik_chain", "solve_chain", "drag_joint", "rotation_between"]
+__all__ = ["fabrik", "two_bone", "aim_joint", "ik_chain", "solve_chain", "drag_joint",
+           "rotation_between"]
 
 
-def fabrik(positions, target, tolerance=1e-6, max_iterations=30):
-    """Move a chain of points so its end reaches ``target``, keeping segment lengths.
-
-    Parameters
-    ----------
-    positions : (N, 3) float
-        Joint positions from the fixed base (row 0) to the end effector (row N-1), N >= 2.
-    target : (3,) float
-    tolerance : float
-        Stop when the end is this close to the target (model units).
-    max_iterations : int
-
-    Returns
-    -------
-    solved : (N, 3) float64
-        New positions; row 0 unchanged. When the target is out of reach the chain lies
-        straight, pointing at it.
-    """
-    p = np.array(positions, dtype=np.float64)
-    target = np.asarray(target, dtype=np.float64).reshape(3)
-    if p.ndim != 2 or p.shape[1] != 3 or len(p) < 2:
-        raise ValueError(f"expected positions of shape (N>=2, 3), got {p.shape}")
-    lengths = np.linalg.norm(np.diff(p, axis=0), axis=1)
-    base = p[0].copy()
-    to_target = target - base
-    dist = np.linalg.norm(to_target)
-    if dist >= lengths.sum():
-        # Out of reach: stretch straight towards the target.
-        direction = to_target / dist if dist > 1e-12 else _unit(p[-1] - p[0])
-        p[1:] = base + np.cumsum(lengths)[:, None] * direction
-        return p
-    for _ in range(max_iterations):
-        if np.linalg.norm(p[-1] - target) <= tolerance:
-            break
-        p[-1] = target  # backward pass: from the end to the base
-        for i in range(len(p) - 2, -1, -1):
-            p[i] = p[i + 1] + _unit(p[i] - p[i + 1]) * lengths[i]
-        p[0] = base  # forward pass: from the base to the end
-        for i in range(1, len(p)):
-            p[i] = p[i - 1] + _unit(p[i] - p[i - 1]) * lengths[i - 1]
-    return p
+# ---------------------------------------------------------------------- rotations
+def _arc(a, b):
+    """Quaternion (x, y, z, w) of the smallest rotation taking direction ``a`` to ``b``;
+    None when either has no length."""
+    na, nb = _norm(a), _norm(b)
+    if na <= _TINY or nb <= _TINY:
+        return None
+    a = [c / na for c in a]
+    b = [c / nb for c in b]
+    axis = _cross(a, b)
+    s, c = _norm(axis), _dot(a, b)
+    if s < _TINY:
+        if c > 0:
+            return [0.0, 0.0, 0.0, 1.0]
+        # Opposite: half a turn about an axis perpendicular to a.
+        perp = _cross(a, [1.0, 0.0, 0.0])
+        if _norm(perp) < 1e-6:
+            perp = _cross(a, [0.0, 1.0, 0.0])
+        return _unit_or(perp) + [0.0]
+    half = 0.5 * math.atan2(s, c)
+    k = math.sin(half) / s
+    return [axis[0] * k, axis[1] * k, axis[2] * k, math.cos(half)]
 
 
-def _unit(v):
-    n = np.linalg.norm(v)
-    return v / n if n > 1e-12 else np.array([0.0, 1.0, 0.0])
+def _qmul(p, q):
+    """Hamilton product ``p * q`` of (x, y, z, w) quaternions (rotate by q, then by p)."""
+    px, py, pz, pw = p
+    qx, qy, qz, qw = q
+    return [pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+            pw * qw - px * qx - py * qy - pz * qz]
 
 
 def rotation_between(a, b):
-    """Smallest rotation taking direction ``a`` to direction ``b``, as a :class:`Rotation`."""
-    a, b = _unit(a), _unit(b)
-    axis = np.cross(a, b)
-    s, c = np.linalg.norm(axis), float(np.dot(a, b))
-    if s < 1e-12:
-        if c > 0:
-            return Rotation.identity()
-        # Opposite: half a turn about any axis perpendicular to a.
-        perp = np.cross(a, [1.0, 0.0, 0.0])
-        if np.linalg.norm(perp) < 1e-6:
-            perp = np.cross(a, [0.0, 1.0, 0.0])
-        return Rotation.from_rotvec(_unit(perp) * np.pi)
-    return Rotation.from_rotvec(axis / s * np.arctan2(s, c))
+    """Smallest rotation taking direction ``a`` to direction ``b``, as a :class:`Rotation`.
+
+    A direction of zero length stands for +Y."""
+    a, b = np.asarray(a, dtype=np.float64).tolist(), np.asarray(b, dtype=np.float64).tolist()
+    return Rotation.from_quat(_arc(_unit_or(a), _unit_or(b)))
+
+
+def _local_matrix(pose, j):
+    """(4, 4) local matrix ``T · R · S`` of joint ``j`` of ``pose`` (as
+    :func:`~rigedit.model.transforms.compose_trs` builds it, for one joint without SciPy's
+    per-call overhead)."""
+    x, y, z, w = pose.rotation[j].tolist()
+    n = x * x + y * y + z * z + w * w
+    s = 2.0 / n if n > 0 else 0.0
+    sx, sy, sz = pose.scale[j].tolist()
+    m = np.empty((4, 4))
+    m[0, 0], m[0, 1], m[0, 2] = (1 - s * (y * y + z * z)) * sx, s * (x * y - z * w) * sy, \
+        s * (x * z + y * w) * sz
+    m[1, 0], m[1, 1], m[1, 2] = s * (x * y + z * w) * sx, (1 - s * (x * x + z * z)) * sy, \
+        s * (y * z - x * w) * sz
+    m[2, 0], m[2, 1], m[2, 2] = s * (x * z - y * w) * sx, s * (y * z + x * w) * sy, \
+        (1 - s * (x * x + y * y)) * sz
+    m[:3, 3] = pose.translation[j]
+    m[3] = (0.0, 0.0, 0.0, 1.0)
+    return m
+
+
+def _aim(pose, parent_mat, joint, head, child_pos, target):
+    """Turn ``joint``'s local rotation so ``child_pos`` swings about ``head`` towards
+    ``target`` (model space) by the smallest rotation; ``parent_mat`` (4, 4) is the parent's
+    model matrix, None for a root. No change when either direction has no length."""
+    a, b = _sub(child_pos, head), _sub(target, head)
+    if parent_mat is not None:
+        # The parent's model rotation (scale divided out) turns the model-space swing into a
+        # parent-space one: R_local' = Rp^-1 · delta · Rp · R_local, and Rp^-1 · delta · Rp is
+        # the smallest rotation between the two directions taken into parent space.
+        lin = parent_mat[:3, :3]
+        rp = (lin / np.maximum(np.sqrt((lin * lin).sum(axis=0)), _TINY)).T.tolist()
+        a = [_dot(rp[0], a), _dot(rp[1], a), _dot(rp[2], a)]
+        b = [_dot(rp[0], b), _dot(rp[1], b), _dot(rp[2], b)]
+    q = _arc(a, b)
+    if q is None:
+        return
+    q = _qmul(q, pose.rotation[joint].tolist())
+    n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    pose.rotation[joint] = (q[0] / n, q[1] / n, q[2] / n, q[3] / n)
 
 
 def aim_joint(skeleton, pose, model_mats, joint, child_pos, target):
@@ -95,20 +125,15 @@ def aim_joint(skeleton, pose, model_mats, joint, child_pos, target):
         Model matrices of ``pose`` before the change.
     joint : int
     child_pos, target : (3,) float
-        Model-space points.
+        Model-space points. Nothing turns when either lies on the joint's head.
     """
-    head = model_mats[joint, :3, 3]
-    delta = rotation_between(np.asarray(child_pos) - head, np.asarray(target) - head)
     parent = skeleton.parents[joint]
-    if parent >= 0:
-        lin = model_mats[parent, :3, :3]
-        # The parent's model rotation (scale divided out) turns the model-space delta into a
-        # parent-space one: R_local' = Rp^-1 · delta · Rp · R_local.
-        rp = Rotation.from_matrix(lin / np.linalg.norm(lin, axis=0, keepdims=True))
-        delta = rp.inv() * delta * rp
-    pose.rotation[joint] = (delta * Rotation.from_quat(pose.rotation[joint])).as_quat()
+    _aim(pose, model_mats[parent] if parent >= 0 else None, joint,
+         model_mats[joint, :3, 3].tolist(), np.asarray(child_pos, dtype=np.float64).tolist(),
+         np.asarray(target, dtype=np.float64).tolist())
 
 
+# ---------------------------------------------------------------------- chains
 def ik_chain(skeleton, joint, length):
     """Joints an IK drag of ``joint`` rotates, from the top of the chain down.
 
@@ -131,6 +156,18 @@ def ik_chain(skeleton, joint, length):
     return chain[::-1]
 
 
+def _path_below(parents, top, joint):
+    """Joints from just below ``top`` down to ``joint`` (its descendant), top first."""
+    path = []
+    while joint != top:
+        if joint < 0:
+            raise ValueError(f"expected joint {path[0] if path else joint} to be a descendant "
+                             f"of joint {top}, got none")
+        path.append(int(joint))
+        joint = parents[joint]
+    return path[::-1]
+
+
 def solve_chain(skeleton, pose, chain, end, target, fk):
     """Rotate the joints of ``chain`` (top first) so joint ``end`` reaches ``target``.
 
@@ -140,20 +177,46 @@ def solve_chain(skeleton, pose, chain, end, target, fk):
     pose : Pose
         Modified in place.
     chain : list[int]
-        Rotated joints, top first; ``end`` is a descendant of the last one.
+        Rotated joints, top first; each a descendant of the one before, ``end`` a descendant
+        of the last one.
     end : int
     target : (3,) float
     fk : callable
-        ``fk(pose) -> (J, 4, 4)`` model matrices.
+        ``fk(pose) -> (J, 4, 4)`` model matrices (forward kinematics of the pose's local
+        matrices). Called once: below the top of the chain each joint's model matrix is its
+        parent's times its local matrix.
     """
     model = fk(pose)
-    points = np.vstack([model[chain, :3, 3], model[end, :3, 3]])
-    solved = fabrik(points, target) if len(chain) > 1 else np.vstack([points[0], target])
+    path = list(chain) + [end]
+    points = model[path, :3, 3]
+    target = np.asarray(target, dtype=np.float64).reshape(3)
+    if len(chain) == 1:
+        solved = [points[0], target]
+    elif len(chain) == 2:
+        solved = two_bone(points, target, frame=model[chain[1], :3, :3])
+    else:
+        solved = fabrik(points, target)
+    parents = skeleton.parents
+    top_parent = parents[chain[0]]
+    parent_mat = model[top_parent] if top_parent >= 0 else None
+    mat = model[chain[0]]
     for k, j in enumerate(chain):
-        if k > 0:
-            model = fk(pose)
-        nxt = chain[k + 1] if k + 1 < len(chain) else end
-        aim_joint(skeleton, pose, model, j, model[nxt, :3, 3], solved[k + 1])
+        below = _path_below(parents, j, path[k + 1])
+        between = [_local_matrix(pose, x) for x in below[:-1]]   # usually none
+        offset = pose.translation[below[-1]]   # the next joint in its parent's frame
+        for m in reversed(between):
+            offset = m[:3, :3] @ offset + m[:3, 3]
+        child = mat[:3, :3] @ offset + mat[:3, 3]
+        _aim(pose, parent_mat, j, mat[:3, 3].tolist(), child.tolist(),
+             np.asarray(solved[k + 1]).tolist())
+        if k + 1 < len(chain):
+            # Carry the new matrix down to the next chain joint and its parent.
+            mat = _local_matrix(pose, j) if parent_mat is None else \
+                parent_mat @ _local_matrix(pose, j)
+            for m in between:
+                mat = mat @ m
+            parent_mat = mat
+            mat = mat @ _local_matrix(pose, below[-1])
 
 
 def drag_joint(skeleton, pose, joint, target, chain_length=1, fk=None):
@@ -161,7 +224,8 @@ def drag_joint(skeleton, pose, joint, target, chain_length=1, fk=None):
 
     A root (no parent) is translated there, so the whole character moves. Any other joint
     rotates its IK chain (:func:`ik_chain`): with length 1 the parent turns so the bone points
-    at the target, keeping its length; longer chains are solved with FABRIK.
+    at the target, keeping its length; a chain of 2 is solved in closed form
+    (:func:`two_bone`), longer chains with FABRIK.
 
     Parameters
     ----------
