@@ -8,8 +8,8 @@ file untouched.
 
 Per frame the recorder skins the mesh (positions and normals in one pass), moves the camera,
 renders, reads the pixels into a reused buffer (:class:`FrameReader`) and queues them for a
-writer thread that composites the captured background and feeds ffmpeg, so encoding overlaps
-the next render (README, Speed > Recording, for the measured rates).
+writer thread that feeds ffmpeg, whose one encoding thread runs beside the next render
+(README, Speed > Recording, for the measured rates).
 """
 from __future__ import annotations
 
@@ -32,6 +32,8 @@ __all__ = ["record_clip", "frame_times", "camera_state", "apply_camera", "VIDEO_
            "RecordingCancelled", "FrameReader"]
 
 VIDEO_SUFFIXES = (".mp4", ".gif")
+#: One colour: a gradient is a full-frame quad in software OpenGL (about 6 ms a 1280x720 frame)
+BACKGROUND = "#dadfe5"
 
 
 class RecordingCancelled(Exception):
@@ -68,7 +70,10 @@ class _Writer:
                 self.writer = imageio.get_writer(
                     str(self.tmp), format="FFMPEG", mode="I", fps=fps, codec="libx264",
                     pixelformat="yuv420p", quality=quality, macro_block_size=2,
-                    output_params=["-preset", preset], ffmpeg_log_level="error")
+                    # one x264 thread: the render uses the other core (x264's default
+                    # frame threads cost 1-2 ms more CPU a frame for the same file)
+                    output_params=["-preset", preset, "-threads", "1"],
+                    ffmpeg_log_level="error")
             except BaseException:   # Ctrl-C while ffmpeg starts: no writer to abort yet
                 with contextlib.suppress(OSError):
                     self.tmp.unlink()
@@ -184,7 +189,7 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
     try:
         plotter.enable_anti_aliasing("msaa", multi_samples=multi_samples) if multi_samples \
             else plotter.disable_anti_aliasing()
-        plotter.set_background("#eef1f4", top="#c5ccd6")
+        plotter.set_background(BACKGROUND)
         # normals skinned with the vertices: no normals filter over the mesh each frame
         scene = RigScene(plotter, rig, show_skeleton=show_skeleton, show_floor=show_floor,
                          skinning=skinning, skinned_normals=True, floor_style="lines")
@@ -205,7 +210,7 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         # pyvista's render() does nothing until a first show() or screenshot()
         plotter.screenshot(return_img=False)
         depth = 2
-        reader = FrameReader(plotter, buffers=depth + 2, backdrop=not multi_samples)
+        reader = FrameReader(plotter, buffers=depth + 2)
         writer = _ThreadedWriter(_Writer(path, fps, quality, preset), depth, reader.image)
         for i, t in enumerate(times):
             if clip is not None:
@@ -236,72 +241,26 @@ class FrameReader:
     """Reads the rendered frame's pixels into a ring of preallocated buffers (no per-frame
     filter or array as ``plotter.screenshot`` makes).
 
-    With ``backdrop=True`` the renderer's background (a gradient) is captured once and no
-    longer drawn: each frame renders over a cleared, fully transparent background and
-    :meth:`image` puts the captured backdrop where the alpha is 0. Filling 1280x720 with the
-    gradient cost about 6 ms a frame in software OpenGL; the compositing runs in the writer
-    thread. It is used only if a test frame composites to exactly the pixels the gradient
-    gave (:attr:`backdrop` says whether); edges blended by multi-sampling would not, so the
-    recorder asks for it only without multi-sampling.
-
     Parameters
     ----------
     plotter : pyvista.Plotter
-        Rendered off-screen at least once (pyvista's ``render()`` does nothing before that),
-        and with ``backdrop`` its last render shows the scene as it is now (the reference
-        the backdrop's compositing must reproduce).
+        Rendered off-screen at least once (pyvista's ``render()`` does nothing before that).
     buffers : int
         How many frames may be in use at once (queued for the encoder): a buffer is written
         again only after ``buffers - 1`` further reads.
-    backdrop : bool
     """
 
-    def __init__(self, plotter, buffers=4, backdrop=False):
+    def __init__(self, plotter, buffers=4):
+        import vtk
+
         self.plotter = plotter
         self.ren_win = plotter.render_window
         self.width, self.height = (int(s) for s in self.ren_win.GetSize())
-        self.backdrop = None
-        self._channels = 3
-        self._make_buffers(buffers)
-        if backdrop:
-            self._capture_backdrop()
-
-    def _make_buffers(self, count):
-        import vtk
-
-        self._vtk = [vtk.vtkUnsignedCharArray() for _ in range(max(1, count))]
+        self._vtk = [vtk.vtkUnsignedCharArray() for _ in range(max(1, buffers))]
         for arr in self._vtk:
-            arr.SetNumberOfComponents(self._channels)
+            arr.SetNumberOfComponents(3)
             arr.SetNumberOfTuples(self.width * self.height)
         self._next = 0
-
-    def _capture_backdrop(self):
-        plotter, renderer = self.plotter, self.plotter.renderer
-        # the frame the caller last rendered (the scene as it is): no render of our own
-        reference = self.image(self.read()).copy()
-        shown = [(actor, actor.GetVisibility()) for actor in renderer.GetActors()]
-        for actor, _ in shown:
-            actor.SetVisibility(False)
-        plotter.render()
-        backdrop = self.image(self.read()).copy()
-        for actor, visible in shown:
-            actor.SetVisibility(visible)
-        gradient, alpha = renderer.GetGradientBackground(), renderer.GetBackgroundAlpha()
-        renderer.GradientBackgroundOff()
-        renderer.SetBackgroundAlpha(0.0)
-        self.ren_win.AlphaBitPlanesOn()
-        self._channels = 4
-        self._make_buffers(len(self._vtk))
-        # rows bottom-up, as VTK reads them; RGBA, opaque, to composite whole pixels
-        self.backdrop = np.dstack([backdrop[::-1], np.full(backdrop.shape[:2], 255, np.uint8)])
-        renderer.ResetCameraClippingRange()
-        plotter.render()
-        if not np.array_equal(self.image(self.read())[..., :3], reference):
-            # no alpha channel, or something drawn translucent: keep drawing the gradient
-            renderer.SetGradientBackground(gradient)
-            renderer.SetBackgroundAlpha(alpha)
-            self.backdrop, self._channels = None, 3
-            self._make_buffers(len(self._vtk))
 
     def read(self):
         """The last rendered frame as read, for :meth:`image` (which may run in another
@@ -311,31 +270,19 @@ class FrameReader:
         arr = self._vtk[self._next]
         self._next = (self._next + 1) % len(self._vtk)
         # the front buffer, which screenshot() reads
-        if self._channels == 4:
-            self.ren_win.GetRGBACharPixelData(0, 0, self.width - 1, self.height - 1, 1, arr, 0)
-        else:
-            self.ren_win.GetPixelData(0, 0, self.width - 1, self.height - 1, 1, arr, 0)
-        return vtk_to_numpy(arr).reshape(self.height, self.width, self._channels)
+        self.ren_win.GetPixelData(0, 0, self.width - 1, self.height - 1, 1, arr, 0)
+        return vtk_to_numpy(arr).reshape(self.height, self.width, 3)
 
-    def image(self, raw):
+    @staticmethod
+    def image(raw):
         """The picture of a :meth:`read` frame, top row first (VTK's rows run bottom-up).
 
         Returns
         -------
-        image : (H, W, 3) uint8, or (H, W, 4) uint8 RGBA with opaque alpha with a backdrop
-            A view of ``raw`` without a backdrop, a new array with one. RGBA goes to ffmpeg
-            as it is (it converts to YUV in its own process): dropping the alpha here was a
-            strided copy as costly as the compositing.
+        image : (H, W, 3) uint8
+            A view of ``raw``.
         """
-        if self.backdrop is None:
-            return raw[::-1]
-        out = np.empty((self.height, self.width, 4), np.uint8)
-        # whole pixels as 32-bit words: one masked copy instead of one per channel; written
-        # bottom-up so that ``out`` itself is top-down and contiguous
-        flipped = out.view(np.uint32)[::-1, :, 0]
-        np.copyto(flipped, raw.view(np.uint32)[..., 0])
-        np.copyto(flipped, self.backdrop.view(np.uint32)[..., 0], where=raw[..., 3] == 0)
-        return out
+        return raw[::-1]
 
 
 class _ThreadedWriter:
@@ -401,7 +348,7 @@ def _use_egl_without_display():
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 
-def _grid_floor(plotter, behind="#c3c9d0"):
+def _grid_floor(plotter, behind=BACKGROUND):
     """The floor's grid lines (the scene's "lines" floor) in one colour pre-blended with the
     colour they show over. Filling the floor plane is what costs in software OpenGL: measured
     at 1280x720 on the quadruped, 14 frames/s with the filled translucent floor against 21
