@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
-"""What the joint spheres cost in the editor, in one run (issue 12, section 1): the glyph
-actor of today against the forty ``vtkSphereWidget`` s it replaced.
+"""What the joint spheres cost in the editor, in one run (issue 12, section 1): the actor of
+sphere imposters of today against the glyph actor of 144-triangle spheres before it and the
+forty ``vtkSphereWidget`` s before that.
 
 1. Static re-renders of the editor's 3D view (the quadruped, side view, window 1280x720 by
    default) in three settings, interleaved over rounds (the machine's speed drifts), median
-   of the rounds' medians: the joint spheres as one glyph actor (the editor now); no joint
-   spheres; forty vtkSphereWidgets built as the editor built them before (16 x 12 resolution,
-   surface, in the overlay renderer), glyphs hidden. The joints' cost is each setting minus
+   of the rounds' medians: the joint spheres as one actor of imposters (the editor now); no
+   joint spheres; one ``vtkGlyph3DMapper`` actor of 12 x 8 spheres (144 triangles) at the same
+   points and colours; forty vtkSphereWidgets built as the editor built them before (16 x 12
+   resolution, surface, in the overlay renderer), the imposters hidden. The joints' cost is each setting minus
    the one without spheres. Wall time and this process's CPU time (all its threads).
 2. Python per mouse move: moving all spheres onto a new pose (glyph points in place against
    forty ``SetCenter`` calls) and the hover pick of the mouse ray against every sphere.
@@ -67,29 +69,61 @@ def old_widgets(w):
     return widgets
 
 
-def compare_look(w, set_widgets, folder=None):
-    """Pixels of the view with the glyph spheres against the same view with the widgets."""
-    w.plotter.render()
-    glyph = w.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
-    w.gizmos.set_visible(False)
-    set_widgets(True)
-    w.plotter.render()
-    widget = w.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
-    set_widgets(False)
-    w.gizmos.set_visible(True)
-    w.plotter.render()
-    diff = np.abs(glyph - widget).max(axis=2)
-    changed = diff > 8
-    print("\nthe look: view with glyphs vs with widgets")
-    print(f"  pixels differing by more than 8 levels: {changed.mean():.3%} of the view; "
-          f"their mean difference {diff[changed].mean() if changed.any() else 0:.1f} levels; "
-          f"mean over all pixels {np.abs(glyph - widget).mean():.2f}")
-    if folder:
-        import imageio.v2 as imageio
+def old_glyphs(w):
+    """The joints as the editor drew them before the imposters: one ``vtkGlyph3DMapper``
+    actor of 12 x 8 spheres (144 triangles) at the same points, in the same colours."""
+    import vtk
 
+    from rigedit.render.joint_glyphs import SPHERE_COLOR
+
+    source = vtk.vtkSphereSource()
+    source.SetRadius(w.gizmos.radius)
+    source.SetThetaResolution(12)
+    source.SetPhiResolution(8)
+    mapper = vtk.vtkGlyph3DMapper()
+    mapper.SetInputData(w.gizmos.glyphs.points)
+    mapper.SetSourceConnection(source.GetOutputPort())
+    mapper.ScalingOff()
+    mapper.OrientOff()
+    mapper.SetScalarModeToUsePointFieldData()
+    mapper.SelectColorArray("rgb")
+    mapper.SetColorModeToDirectScalars()
+    actor = vtk.vtkActor()
+    actor.SetMapper(mapper)
+    actor.GetProperty().SetSpecular(0.4)
+    actor.GetProperty().SetSpecularColor(SPHERE_COLOR)
+    actor.SetVisibility(False)
+    w.overlay.AddActor(actor)
+    return actor
+
+
+def compare_look(w, others, folder=None):
+    """Pixels of the view with the imposters against the same view with each older way
+    (``others``: name -> set_visible(on))."""
+    import imageio.v2 as imageio
+
+    w.plotter.render()
+    now = w.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+    shots = {"imposters": now}
+    for name, show in others.items():
+        w.gizmos.set_visible(False)
+        show(True)
+        w.plotter.render()
+        shots[name] = w.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+        show(False)
+        w.gizmos.set_visible(True)
+        w.plotter.render()
+        diff = np.abs(now - shots[name]).max(axis=2)
+        changed = diff > 8
+        print(f"\nthe look: view with imposters vs with {name}")
+        print(f"  pixels differing by more than 8 levels: {changed.mean():.3%} of the view; "
+              f"their mean difference {diff[changed].mean() if changed.any() else 0:.1f} "
+              f"levels; mean over all pixels {np.abs(now - shots[name]).mean():.2f}")
+    if folder:
         Path(folder).mkdir(parents=True, exist_ok=True)
-        imageio.imwrite(Path(folder) / "gizmos-glyphs.png", glyph.astype(np.uint8))
-        imageio.imwrite(Path(folder) / "gizmos-widgets.png", widget.astype(np.uint8))
+        for name, shot in shots.items():
+            imageio.imwrite(Path(folder) / f"gizmos-{name.replace(' ', '-')}.png",
+                            shot.astype(np.uint8))
 
 
 def drag_frames(app, w, rounds=3, moves=120):
@@ -131,6 +165,7 @@ def main():
             return
         render = w.plotter.render_window.Render
         widgets = old_widgets(w)
+        glyph_actor = old_glyphs(w)
         iren = w.plotter.iren.interactor
 
         def set_widgets(on):
@@ -139,9 +174,12 @@ def main():
                 s.SetEnabled(on)
 
         settings = [
-            ("joint spheres: one glyph actor (now)", lambda: None, lambda: None),
+            ("joint spheres: one actor of imposters (now)", lambda: None, lambda: None),
             ("no joint spheres", lambda: w.gizmos.set_visible(False),
              lambda: w.gizmos.set_visible(True)),
+            ("joint spheres: one glyph actor, 144 triangles each (before)",
+             lambda: (w.gizmos.set_visible(False), glyph_actor.SetVisibility(True)),
+             lambda: (glyph_actor.SetVisibility(False), w.gizmos.set_visible(True))),
             ("joint spheres: 40 vtkSphereWidgets (before)",
              lambda: (w.gizmos.set_visible(False), set_widgets(True)),
              lambda: (set_widgets(False), w.gizmos.set_visible(True))),
@@ -163,7 +201,7 @@ def main():
             for label in v:
                 extra = "" if label == none else \
                     f"  joints {med[label] - med[none]:+6.2f} ({best[label] - best[none]:+.2f})"
-                print(f"  {label:46s} {med[label]:6.2f} ({best[label]:6.2f}){extra}")
+                print(f"  {label:58s} {med[label]:6.2f} ({best[label]:6.2f}){extra}")
 
         # Python of a mouse move
         heads = w.gizmos.positions.copy() + 0.01
@@ -176,10 +214,11 @@ def main():
         x, y = w.gizmos.display_position(len(heads) // 2)
         pick_ms = _median_ms(lambda: w.gizmos.pick(x + 40, y + 40), n=200)
         print("\nper mouse move (Python)")
-        print(f"  move all spheres onto a pose: glyph points {glyph_ms:.3f} ms, "
+        print(f"  move all spheres onto a pose: imposter points {glyph_ms:.3f} ms, "
               f"40 SetCenter {widget_ms:.3f} ms")
         print(f"  hover pick (mouse ray against {len(heads)} spheres): {pick_ms:.3f} ms")
-        compare_look(w, set_widgets, args.save)
+        compare_look(w, {"glyphs": glyph_actor.SetVisibility, "widgets": set_widgets},
+                     args.save)
         for s in widgets:
             s.SetEnabled(False)
             s.SetInteractor(None)

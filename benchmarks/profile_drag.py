@@ -168,7 +168,7 @@ def layer_costs(app, w, rounds=5, n=15):
 
     settings = [
         ("everything shown (as in the drag)", lambda: None, lambda: None),
-        ("joint spheres hidden (40 sphere widgets)",
+        ("joint spheres hidden",
          lambda: giz.set_visible(False), lambda: giz.set_visible(True)),
         ("axis arrows hidden", lambda: axes.set_visible(False), lambda: axes.set_visible(True)),
         ("bones hidden", lambda: scene.set_skeleton_visible(False),
@@ -199,20 +199,19 @@ def layer_triangles(w):
     import pyvista as pv
     import vtk
 
-    if hasattr(w.gizmos, "glyphs"):  # one glyph actor (issue 12): its sphere source
-        w.gizmos.glyphs.source.Update()
-        sphere = pv.wrap(w.gizmos.glyphs.source.GetOutput()).triangulate()
+    if hasattr(w.gizmos, "glyphs"):  # one actor of imposters: a square (2 triangles) each
+        sphere_cells = 2
     else:
         pd = vtk.vtkPolyData()
         w.gizmos.widgets[0].GetPolyData(pd)
-        sphere = pv.wrap(pd).triangulate()
+        sphere_cells = pv.wrap(pd).triangulate().n_cells
     arrows = sum(pv.wrap(a.GetMapper().GetInput()).triangulate().n_cells for a in w.axes.actors)
     floor = w.plotter.actors["rig-floor"].GetMapper().GetInput()
     grid = w.plotter.actors.get("rig-grid")
     bones = w.scene.bones
     return {"mesh triangles": len(w.document.rig.faces),
-            "joint spheres": f"{len(w.gizmos.positions)} x {sphere.n_cells} = "
-                             f"{len(w.gizmos.positions) * sphere.n_cells:,} triangles",
+            "joint spheres": f"{len(w.gizmos.positions)} x {sphere_cells} = "
+                             f"{len(w.gizmos.positions) * sphere_cells:,} triangles",
             "axis arrows": f"{arrows:,} triangles",
             "bones": f"{bones.n_lines} lines",
             "floor plane": f"{pv.wrap(floor).triangulate().n_cells:,} triangles",
