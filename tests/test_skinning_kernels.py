@@ -171,3 +171,20 @@ def test_vector_kernel_refuses_a_palette_it_would_read_past():
     with pytest.raises(ValueError, match="16 floats"):
         kernels.lbs(binding._rest32, binding._indices32, binding._weights32,
                     np.zeros((5, 12), np.float32), np.empty((100, 3), np.float32))
+
+
+@pytest.mark.parametrize("v", [1, 15, 16, 17, 1023, 1024 + 16 + 5, 3 * 1024 + 40])
+@pytest.mark.parametrize("scale", [False, True])
+def test_dqs_kernel_blocks_and_their_remainders_agree_with_numpy(v, scale):
+    """The DQS kernel transforms 16 vertices at a time in tasks of DQS_TASK vertices; counts
+    around those sizes take the one-vertex path for a task's last few, and every vertex must
+    be written (the output starts as NaN)."""
+    assert skinning_kernels.DQS_TASK == 1024
+    binding = random_binding(v, 12, 8, seed=v)
+    pal = random_palette(12, seed=v, scale=scale)
+    ref = binding.skin(pal, method="dqs", backend="numpy").copy()
+    for threads in (1, 2):
+        binding.threads = threads
+        out = np.full((v, 3), np.nan, np.float32)
+        binding.skin(pal, method="dqs", out=out, backend="numba")
+        assert np.abs(out - ref).max() <= 4e-6 * max(1.0, np.abs(ref).max())

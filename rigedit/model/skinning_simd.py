@@ -20,7 +20,8 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-__all__ = ["blend_apply4", "blend_apply4_normal", "dq_blend4", "ROW"]
+__all__ = ["blend_apply4", "blend_apply4_normal", "dq_blend4_into", "dq_apply16", "ROW",
+           "DQ_BLOCK"]
 
 ROW = 16  # floats per palette row
 _F32 = ir.FloatType()
@@ -104,37 +105,121 @@ def blend_apply4_normal(typingctx, palette, j0, j1, j2, j3, w0, w1, w2, w3, x, y
 
 
 _DQ = ir.VectorType(_F32, 8)
+#: Vertices one :func:`dq_apply16` transforms: one 16-float vector per coordinate.
+DQ_BLOCK = 16
+
+
+def _wide(builder, index):
+    return index if index.type.width == 64 else builder.sext(index, _I64)
+
+
+def _rows(context, builder, array_type, array, row, width, n_floats):
+    """Pointer to ``array[row, 0]`` of a C-contiguous float32 array of rows of ``width`` floats,
+    as a pointer to a vector of ``n_floats``."""
+    data = context.make_array(array_type)(context, builder, array).data
+    address = builder.gep(data, [builder.mul(_wide(builder, row), ir.Constant(_I64, width))])
+    return builder.bitcast(address, ir.VectorType(_F32, n_floats).as_pointer())
+
+
+def _mask(indices):
+    return ir.Constant(ir.VectorType(_I32, len(indices)), list(indices))
 
 
 @intrinsic
-def dq_blend4(typingctx, dq, signs, pivot, j0, j1, j2, j3, w0, w1, w2, w3):
-    """sum_k s_k w_k dq[j_k] for four influences, a dual quaternion as 8 floats (not
-    normalised), with s_k = signs[pivot, j_k]: -1 when dq[j_k]'s real part points away from
-    dq[pivot]'s (the antipodality flip), else 1. dq is (J, 8) float32: real (x, y, z, w), then
-    dual; signs (J, J) float32, computed once per frame (a table lookup per influence instead
-    of a 4-term dot product and a compare)."""
+def dq_blend4_into(typingctx, dq, signs, pivot, j0, j1, j2, j3, w0, w1, w2, w3, blend, row,
+                   accumulate):
+    """blend[row] = (or += when ``accumulate``) sum_k s_k w_k dq[j_k] for four influences, a
+    dual quaternion as 8 floats (not normalised), with s_k = signs[pivot, j_k]: -1 when
+    dq[j_k]'s real part points away from dq[pivot]'s (the antipodality flip), else 1.
+
+    dq (J, 8) float32: real (x, y, z, w), then dual; signs (J, J) float32, computed once per
+    frame (a table lookup per influence instead of a 4-term dot product and a compare); blend
+    (DQ_BLOCK, 8) float32, written with one 8-float store."""
     f32 = types.float32
-    sig = types.UniTuple(f32, 8)(dq, signs, pivot, *([types.int32] * 4), *([f32] * 4))
+    sig = types.none(dq, signs, pivot, *([types.int32] * 4), *([f32] * 4), blend, row,
+                     accumulate)
 
     def codegen(context, builder, signature, args):
         table = context.make_array(signature.args[0])(context, builder, args[0])
         sign_table = context.make_array(signature.args[1])(context, builder, args[1])
         n_joints = builder.extract_value(sign_table.shape, 1)
-
-        def wide(joint):
-            return joint if joint.type.width == 64 else builder.sext(joint, _I64)
-
-        sign_row = builder.mul(wide(args[2]), n_joints)
+        sign_row = builder.mul(_wide(builder, args[2]), n_joints)
         acc = None
         for joint, weight in zip(args[3:7], args[7:11]):
-            joint = wide(joint)
+            joint = _wide(builder, joint)
             address = builder.gep(table.data, [builder.mul(joint, ir.Constant(_I64, 8))])
             q = builder.load(builder.bitcast(address, _DQ.as_pointer()), align=4)
             sign = builder.load(builder.gep(sign_table.data, [builder.add(sign_row, joint)]))
             signed = builder.fmul(weight, sign, flags=_FAST)
             term = builder.fmul(q, _splat(builder, signed, _DQ), flags=_FAST)
             acc = term if acc is None else builder.fadd(acc, term, flags=_FAST)
-        out = [builder.extract_element(acc, ir.Constant(_I32, i)) for i in range(8)]
-        return context.make_tuple(builder, signature.return_type, out)
+        target = _rows(context, builder, signature.args[11], args[11], args[12], 8, 8)
+        with builder.if_else(args[13]) as (add, first):
+            with add:
+                builder.store(builder.fadd(builder.load(target, align=4), acc, flags=_FAST),
+                              target, align=4)
+            with first:
+                builder.store(acc, target, align=4)
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@intrinsic
+def dq_apply16(typingctx, blend, points, p0, out, v0):
+    """out[v0 : v0 + 16] = points[p0 : p0 + 16] moved by the blended dual quaternions
+    blend[0 : 16] (DQ_BLOCK rows of 8 floats as :func:`dq_blend4_into` leaves them, not
+    normalised), 16 vertices at a time: each of the 8 blend components and each coordinate
+    is one 16-float vector, so the transform's 50-odd operations are shared by 16 vertices.
+
+    With the blend (r, w; d, e) normalised by |(r, w)|: p' = p + 2 r x (r x p + w p)
+    + 2 (w d - e r + r x d). Every term is quadratic in the blend, so the normalisation is one
+    factor 2 / |(r, w)|^2 (no square root). points and out (N, 3) float32."""
+    sig = types.none(blend, points, p0, out, v0)
+    n = DQ_BLOCK
+
+    def codegen(context, builder, signature, args):
+        rows = builder.load(_rows(context, builder, signature.args[0], args[0],
+                                  ir.Constant(_I64, 0), 8, 8 * n), align=4)
+        # De-interleave: component c of the 16 blends, then x, y, z of the 16 points.
+        b0, b1, b2, b3, e0, e1, e2, e3 = (
+            builder.shuffle_vector(rows, rows, _mask(range(c, 8 * n, 8))) for c in range(8))
+        pts = builder.load(_rows(context, builder, signature.args[1], args[1], args[2], 3,
+                                 3 * n), align=4)
+        x, y, z = (builder.shuffle_vector(pts, pts, _mask(range(c, 3 * n, 3)))
+                   for c in range(3))
+
+        def mul(a, b):
+            return builder.fmul(a, b, flags=_FAST)
+
+        def add(a, b):
+            return builder.fadd(a, b, flags=_FAST)
+
+        def sub(a, b):
+            return builder.fsub(a, b, flags=_FAST)
+
+        vec = ir.VectorType(_F32, n)
+        norm = add(add(mul(b0, b0), mul(b1, b1)), add(mul(b2, b2), mul(b3, b3)))
+        # An exact division (no reciprocal approximation), as numba's FASTMATH allows.
+        two = builder.fdiv(_splat(builder, ir.Constant(_F32, 2.0), vec), norm,
+                           flags=("arcp", "contract", "reassoc", "nsz"))
+        # c = r x p + w p, t = w d - e r + r x d (unnormalised)
+        cx = add(sub(mul(b1, z), mul(b2, y)), mul(b3, x))
+        cy = add(sub(mul(b2, x), mul(b0, z)), mul(b3, y))
+        cz = add(sub(mul(b0, y), mul(b1, x)), mul(b3, z))
+        tx = add(sub(mul(b3, e0), mul(e3, b0)), sub(mul(b1, e2), mul(b2, e1)))
+        ty = add(sub(mul(b3, e1), mul(e3, b1)), sub(mul(b2, e0), mul(b0, e2)))
+        tz = add(sub(mul(b3, e2), mul(e3, b2)), sub(mul(b0, e1), mul(b1, e0)))
+        ox = add(x, mul(two, add(sub(mul(b1, cz), mul(b2, cy)), tx)))
+        oy = add(y, mul(two, add(sub(mul(b2, cx), mul(b0, cz)), ty)))
+        oz = add(z, mul(two, add(sub(mul(b0, cy), mul(b1, cx)), tz)))
+        # Interleave x, y, z back into 16 rows of 3.
+        xy = builder.shuffle_vector(ox, oy, _mask(range(2 * n)))
+        zz = builder.shuffle_vector(oz, oz, _mask(list(range(n)) * 2))
+        xyz = builder.shuffle_vector(xy, zz, _mask([c * n + i for i in range(n)
+                                                    for c in range(3)]))
+        builder.store(xyz, _rows(context, builder, signature.args[3], args[3], args[4], 3,
+                                 3 * n), align=4)
+        return context.get_dummy_value()
 
     return sig, codegen
