@@ -61,8 +61,8 @@ def bare(rig, clip, frames, fps, size):
 
     from rigedit.model.kinematics import skinning_matrices
     from rigedit.model.skinning import vertex_normals
-    from rigedit.render.recorder import FrameReader
     from rigedit.render.scene import MESH_COLOR, faces_to_vtk
+    from rigedit.render.video_writer import FrameReader
 
     binding = rig.binding
     binding.bind_normals(vertex_normals(binding.rest_vertices, rig.faces))
@@ -103,17 +103,12 @@ def bare(rig, clip, frames, fps, size):
 def frame_like_the_recorder(plotter, rig, clip, frames, fps):
     """The recorder's camera (front view fitted to the vertices the clip sweeps), so both
     plotters fill the same pixels; the walk's root travel over 2 s is small at that size."""
-    import functools
-    import types
+    from rigedit.render.camera import frame_view, front_vector, swept_points, up_vector
+    from rigedit.render.recorder import frame_times
 
-    from rigedit.render.recorder import frame_times, swept_points
-    from rigedit.render.scene import RigScene, front_vector, up_vector
-
-    view = types.SimpleNamespace(plotter=plotter, up=up_vector(rig.up),
-                                 front=front_vector(rig.up))
-    view._fit_distance = functools.partial(RigScene._fit_distance, view)
     times = frame_times(frames / fps, fps)
-    RigScene.view(view, "front", points=swept_points(rig, clip, times))
+    frame_view(plotter, up_vector(rig.up), front_vector(rig.up),
+               swept_points(rig, clip, times), "front")
 
 
 encoder_cpu = []   # ffmpeg's CPU seconds per frame (children of this process), per call

@@ -82,11 +82,11 @@ def test_an_encoder_error_in_the_writer_thread_is_raised_once_and_leaves_no_temp
         rig, tmp_path, monkeypatch):
     import threading
 
-    from rigedit.render import recorder
+    from rigedit.render import video_writer
 
     path = tmp_path / "out.mp4"
     path.write_bytes(b"old video")
-    real_append, written, done = recorder._Writer.append, [], []
+    real_append, written, done = video_writer.VideoWriter.append, [], []
 
     def failing_append(self, frame):
         if len(written) == 3:
@@ -95,7 +95,7 @@ def test_an_encoder_error_in_the_writer_thread_is_raised_once_and_leaves_no_temp
         written.append(frame.shape)
 
     thread_errors = []
-    monkeypatch.setattr(recorder._Writer, "append", failing_append)
+    monkeypatch.setattr(video_writer.VideoWriter, "append", failing_append)
     monkeypatch.setattr(threading, "excepthook", thread_errors.append)
     with pytest.raises(OSError, match="No space left on device"):
         record_clip(rig, rig.clips["bend"], path, fps=10, duration=2.0, size=SIZE,
@@ -123,7 +123,7 @@ def recorder_like_plotter(rig, zoom=1.0):
 
 
 def test_frame_reader_reads_what_screenshot_reads(rig):
-    from rigedit.render.recorder import FrameReader
+    from rigedit.render.video_writer import FrameReader
 
     plotter, other = recorder_like_plotter(rig), recorder_like_plotter(rig, zoom=2.0)
     try:

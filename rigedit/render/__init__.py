@@ -1,4 +1,5 @@
 """pyvista/VTK rendering (never Qt): scene actors and the off-screen recorder."""
-from .scene import RigScene, front_vector, up_vector
+from .camera import front_vector, up_vector
+from .scene import RigScene
 
 __all__ = ["RigScene", "up_vector", "front_vector"]

@@ -1,57 +1,26 @@
-"""The rig's actors in a pyvista plotter: skinned mesh, bones, floor, camera presets.
+"""The rig's actors in a pyvista plotter: skinned mesh, bones, floor, display modes.
 
 Used by the interactive view and the off-screen recorder alike; never imports Qt. The mesh
 is added once and its points are updated in place each frame
-(docs/architecture.md, pitfalls).
+(docs/architecture.md, pitfalls). The camera presets and framing are
+:mod:`rigedit.render.camera`'s.
 """
 from __future__ import annotations
 
 import numpy as np
 import pyvista as pv
 import vtk
-from scipy.spatial.transform import Rotation
 
 from ..model.kinematics import skinning_matrices
 from ..surface import display_texture
+from .camera import frame_view, front_vector, rest_points, up_vector
 from .floor import add_floor
 from .proxy import ProxyActor, write_skin
 
-__all__ = ["RigScene", "up_vector", "front_vector", "faces_to_vtk", "turn_about",
-           "joint_points"]
+__all__ = ["RigScene", "faces_to_vtk"]
 
 MESH_COLOR = "#c9b79c"
 BONE_COLOR = "#2f6fd6"
-
-
-def up_vector(up):
-    """(3,) unit vector of the vertical axis ``"y"`` or ``"z"``."""
-    return np.array([0.0, 1.0, 0.0]) if up == "y" else np.array([0.0, 0.0, 1.0])
-
-
-def front_vector(up):
-    """(3,) direction from the character towards a camera that sees its front.
-
-    Y-up characters (glTF, the bundled ones) face +Z; Z-up ones (Blender exports such as the
-    elk project) face -Y.
-    """
-    return np.array([0.0, 0.0, 1.0]) if up == "y" else np.array([0.0, -1.0, 0.0])
-
-
-def turn_about(vector, axis, degrees):
-    """``vector`` (3,) turned by ``degrees`` about the unit ``axis`` (right-handed)."""
-    return Rotation.from_rotvec(np.radians(degrees) * np.asarray(axis, float)).apply(vector)
-
-
-def joint_points(rig, model):
-    """(J + T, 3) what a mesh-less rig shows of a pose: its joints and bone tails.
-
-    Parameters
-    ----------
-    rig : Rig
-    model : (J, 4, 4) float64
-        Model matrices of the pose.
-    """
-    return np.vstack([model[:, :3, 3], rig.posed_tails(model)[1]])
 
 
 def faces_to_vtk(faces):
@@ -251,21 +220,9 @@ class RigScene:
             self.tails.Modified()
 
     def rest_points(self, samples=12):
-        """(N, 3) points the default camera and the floor are fitted to: a sample of the
-        mesh's vertices; for a rig without a mesh, its joints and bone tails over its first
-        clip (a BVH skeleton's rest pose is arbitrary, its motion is what is shown), or at
-        bind time when it has no clip."""
-        rig = self.rig
-        if self.has_mesh:
-            # the skinned rest pose, not the bind-space vertices: a glTF mesh may be stored in
-            # a frame of its own (CesiumMan's is Z up) that only its joints place
-            return rig.skin(rig.rest_pose())[::max(1, len(rig.vertices) // 4000)]
-        clip = next(iter(rig.clips.values()), None)
-        if clip is None or not clip.tracks:
-            return joint_points(rig, rig.skeleton.bind_matrices)
-        pose = rig.rest_pose()
-        return np.concatenate([joint_points(rig, rig.joint_matrices(clip.sample(t, out=pose)))
-                               for t in np.linspace(0.0, clip.duration, samples)])
+        """(N, 3) points the default camera and the floor are fitted to
+        (:func:`rigedit.render.camera.rest_points` of the rig)."""
+        return rest_points(self.rig, samples)
 
     def _add_floor(self, style):
         points = self.rest_points()
@@ -417,63 +374,14 @@ class RigScene:
 
     # ------------------------------------------------------------------ camera
     def view(self, name="front", angle=0.0, distance=None, target=None, points=None):
-        """Point the camera at the character and frame it.
-
-        Parameters
-        ----------
-        name : {"front", "side", "top", "back"}
-        angle : float
-            Degrees turned about the vertical axis (counter-clockwise seen from above).
-        distance : float, optional
-            Camera distance in units of the character's largest extent; by default the
-            distance at which ``points`` just fit the window, plus a margin.
-        target : (3,) float, optional
-            Point looked at; the centre of the points' bounding box when omitted.
-        points : (N, 3) float, optional
-            What must be in frame; a sample of the rest mesh's vertices when omitted. A
-            recorder passes the vertices of several frames of its clip so raised hands and
-            swinging legs stay in frame.
-        """
+        """Point the camera at the character and frame it: :func:`frame_view
+        <rigedit.render.camera.frame_view>` (which documents the parameters) with this rig's
+        up and front, ``points`` a sample of the rest mesh's vertices when omitted (a
+        recorder passes the vertices of several frames of its clip)."""
         if points is None:
             points = self.rest_points()
-        points = np.asarray(points, dtype=float)
-        lo, hi = points.min(axis=0), points.max(axis=0)
-        center = 0.5 * (lo + hi) if target is None else np.asarray(target, dtype=float)
-        extent = float(np.max(hi - lo)) or 1.0
-        side = np.cross(self.up, self.front)  # the character's left, seen from the front
-        direction = {"front": self.front, "back": -self.front, "side": -side,
-                     "top": self.up}[name]
-        if name != "top":
-            direction = turn_about(direction, self.up, angle)
-            direction = direction + 0.15 * self.up  # a little from above, as a person sees it
-        direction = direction / np.linalg.norm(direction)
-        cam_up = -self.front if name == "top" else self.up
-        cam = self.plotter.camera
-        if distance is None:
-            dist = self._fit_distance(points, center, direction, cam_up, cam.view_angle)
-        else:
-            dist = distance * extent
-        cam.focal_point = center
-        cam.position = center + direction * dist
-        cam.up = cam_up
-        self.plotter.reset_camera_clipping_range()
+        frame_view(self.plotter, self.up, self.front, points, name, angle, distance, target)
         self._view = (name, angle, distance)
-
-    def _fit_distance(self, points, center, direction, cam_up, view_angle, margin=1.08):
-        """Distance along ``direction`` at which all ``points`` fit the viewport: a point at
-        lateral offset ``a`` and depth ``z`` towards the camera needs ``a / tan + z``."""
-        corners = points - center
-        up = cam_up - np.dot(cam_up, direction) * direction
-        up /= np.linalg.norm(up)
-        right = np.cross(direction, up)
-        width, height = self.plotter.window_size
-        aspect = width / height if width > 1 and height > 1 else 4.0 / 3.0  # not shown yet
-        tan_v = np.tan(np.radians(view_angle) / 2.0)
-        tan_h = tan_v * aspect
-        depth = corners @ direction  # corners nearer the camera need more room
-        need_v = np.abs(corners @ up) / tan_v + depth
-        need_h = np.abs(corners @ right) / tan_h + depth
-        return margin * float(max(need_v.max(), need_h.max()))
 
     def follow(self, offset):
         """Shift the camera by ``offset`` (3,) model units, to track root motion."""

@@ -13,7 +13,8 @@ from pathlib import Path
 from PyQt5 import QtCore, QtWidgets
 
 from ..errors import RigFileError
-from ..render.recorder import RecordingCancelled, camera_state, record_clip
+from ..render.camera import camera_state
+from ..render.recorder import RecordingCancelled, record_clip
 
 __all__ = ["RecordDialog", "record_video"]
 
@@ -37,7 +38,7 @@ def record_video(window, path, fps=30, duration=None, size=(1280, 720), start=0.
     camera : {"view", "orbit"} or dict
         ``"view"`` copies the editor's current camera; ``"orbit"`` starts from it and turns
         ``orbit`` degrees about the vertical axis over the recording; a dict is used as is
-        (see :func:`~rigedit.render.recorder.camera_state`).
+        (see :func:`~rigedit.render.camera.camera_state`).
     follow_root : bool
         Move the camera with the root's horizontal motion.
     progress : bool
