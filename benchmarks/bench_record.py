@@ -61,7 +61,8 @@ def bare(rig, clip, frames, fps, size):
 
     from rigedit.model.kinematics import skinning_matrices
     from rigedit.model.skinning import vertex_normals
-    from rigedit.render.scene import MESH_COLOR, faces_to_vtk
+    from rigedit.render.mesh_look import MESH_COLOR
+    from rigedit.render.scene import faces_to_vtk
     from rigedit.render.video_writer import FrameReader
 
     binding = rig.binding

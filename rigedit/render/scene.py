@@ -1,9 +1,10 @@
-"""The rig's actors in a pyvista plotter: skinned mesh, bones, floor, display modes.
+"""The rig's actors in a pyvista plotter: the skinned mesh, its normals, bones, floor, proxy.
 
 Used by the interactive view and the off-screen recorder alike; never imports Qt. The mesh
 is added once and its points are updated in place each frame
 (docs/architecture.md, pitfalls). The camera presets and framing are
-:mod:`rigedit.render.camera`'s.
+:mod:`rigedit.render.camera`'s, the bone actors :mod:`rigedit.render.skeleton_actors`'s,
+the mesh's colours and display modes :mod:`rigedit.render.mesh_look`'s.
 """
 from __future__ import annotations
 
@@ -12,15 +13,13 @@ import pyvista as pv
 import vtk
 
 from ..model.kinematics import skinning_matrices
-from ..surface import display_texture
+from . import mesh_look
 from .camera import frame_view, front_vector, rest_points, up_vector
 from .floor import add_floor
 from .proxy import ProxyActor, write_skin
+from .skeleton_actors import BareSkeleton, add_bones
 
 __all__ = ["RigScene", "faces_to_vtk"]
-
-MESH_COLOR = "#c9b79c"
-BONE_COLOR = "#2f6fd6"
 
 
 def faces_to_vtk(faces):
@@ -82,29 +81,17 @@ class RigScene:
             self._normals.ConsistencyOff()
             self._normals.AutoOrientNormalsOff()
             self._normals.ComputeCellNormalsOff()
-            look = self._surface_look()
+            look = mesh_look.surface_look(rig, self.mesh)
             self.mesh_actor = plotter.add_mesh(self._normals, smooth_shading=True,
                                                specular=0.25, specular_power=20,
                                                name="rig-mesh", **look)
             self._texture = look.get("texture")
             self._connect_normals()
         sk = rig.skeleton
-        # No line from a non-deforming root (a ground-level carrier) to its children: that
-        # "bone" moves no skin and would cut through the body down to the floor.
-        carrier = (sk.parents < 0) & ~sk.deform
-        child = np.flatnonzero((sk.parents >= 0) & ~carrier[np.maximum(sk.parents, 0)])
-        lines = np.column_stack([np.full(len(child), 2), sk.parents[child], child]).ravel()
-        self.bones = pv.PolyData(sk.bind_matrices[:, :3, 3].copy())
-        if len(child):
-            self.bones.lines = lines
-        self.bone_actor = plotter.add_mesh(self.bones, color=BONE_COLOR,
-                                           line_width=3 if self.has_mesh else 5,
-                                           render_lines_as_tubes=False, name="rig-bones",
-                                           reset_camera=False)
+        self.bones, self.bone_actor = add_bones(plotter, sk, bold=not self.has_mesh)
         self.bone_actor.SetVisibility(show_skeleton or not self.has_mesh)
-        self.joint_actor = self.tails = None
-        if not self.has_mesh:
-            self._add_bare_skeleton(plotter)
+        #: The joint balls and tails of a rig with no mesh, or None
+        self.bare_skeleton = None if self.has_mesh else BareSkeleton(plotter, rig)
         self.floor_actor = self._add_floor(floor_style) if show_floor else None
         self.display_mode = "solid"
         self.weights_shown = False
@@ -182,43 +169,6 @@ class RigScene:
             self.mesh.point_data["Normals"][:] = rest_normals
         self._normals_binding = binding
 
-    def _surface_look(self):
-        """``add_mesh`` colour/texture arguments from the rig's surface: its materials as one
-        texture (each part in its own material's texture or base colour, see
-        :func:`rigedit.surface.display_texture`), or rigedit's clay colour without a surface."""
-        surf = getattr(self.rig, "surface", None)
-        if surf is None:
-            return {"color": MESH_COLOR}
-        image, tcoords = display_texture(surf, self.mesh.n_points)
-        self.mesh.active_texture_coordinates = tcoords
-        return {"texture": pv.Texture(image), "color": "white"}
-
-    def _add_bare_skeleton(self, plotter):
-        """Joint balls and End-Site tail segments: what a mesh-less rig shows."""
-        model = self.rig.skeleton.bind_matrices
-        # no ball for a root that only carries the figure (it stays on the floor)
-        self._balls = np.flatnonzero(self.rig.skeleton.deform)
-        self.joints = pv.PolyData(model[self._balls, :3, 3].copy())
-        self.joint_actor = plotter.add_mesh(self.joints, color=BONE_COLOR, point_size=11,
-                                            render_points_as_spheres=True, name="rig-joints",
-                                            reset_camera=False)
-        joints, tails = self.rig.posed_tails(model)
-        n = len(joints)
-        if n:
-            self.tails = pv.PolyData(np.vstack([model[joints, :3, 3], tails]))
-            self.tails.lines = np.column_stack([np.full(n, 2), np.arange(n),
-                                                np.arange(n) + n]).ravel()
-            plotter.add_mesh(self.tails, color=BONE_COLOR, line_width=5, name="rig-tails",
-                             reset_camera=False)
-
-    def _update_bare_skeleton(self, model):
-        self.joints.points[:] = model[self._balls, :3, 3]
-        self.joints.Modified()
-        if self.tails is not None:
-            joints, tails = self.rig.posed_tails(model)
-            self.tails.points[:] = np.vstack([model[joints, :3, 3], tails])
-            self.tails.Modified()
-
     def rest_points(self, samples=12):
         """(N, 3) points the default camera and the floor are fitted to
         (:func:`rigedit.render.camera.rest_points` of the rig)."""
@@ -239,27 +189,12 @@ class RigScene:
                 actor.SetVisibility(bool(visible))
 
     # ------------------------------------------------------------------ display modes
-    DISPLAY_MODES = ("solid", "translucent", "wireframe")
-
     def set_display_mode(self, mode):
         """Show the mesh ``"solid"``, ``"translucent"`` (see-through, with its wireframe, so
-        joints inside stay visible) or ``"wireframe"``."""
-        if mode not in self.DISPLAY_MODES:
-            raise ValueError(f"expected a display mode in {self.DISPLAY_MODES}, got {mode!r}")
+        joints inside stay visible) or ``"wireframe"``
+        (:func:`rigedit.render.mesh_look.set_display_mode`)."""
+        mesh_look.set_display_mode(self.mesh_actor, mode)
         self.display_mode = mode
-        if self.mesh_actor is None:
-            return
-        prop = self.mesh_actor.GetProperty()
-        if mode == "wireframe":
-            prop.SetRepresentationToWireframe()
-            prop.SetOpacity(1.0)
-            prop.EdgeVisibilityOff()
-            prop.SetLineWidth(1.0)
-        else:
-            prop.SetRepresentationToSurface()
-            prop.SetOpacity(1.0 if mode == "solid" else 0.35)
-            prop.SetEdgeVisibility(mode == "translucent")
-            prop.SetEdgeColor(0.35, 0.33, 0.30)
 
     def show_weights(self, weights):
         """Colour the mesh by one joint's influence (weight paint view), or back to its plain
@@ -287,20 +222,8 @@ class RigScene:
         self.mesh.point_data["weight"] = w
         self.mesh.Modified()
         if self._weight_lut is None:
-            lut = vtk.vtkLookupTable()
-            # Blue (no influence) through green and yellow to red (full), as painters expect.
-            lut.SetHueRange(0.667, 0.0)
-            lut.SetSaturationRange(0.85, 0.85)
-            lut.SetValueRange(0.95, 0.95)
-            lut.SetNumberOfTableValues(256)
-            lut.Build()
-            self._weight_lut = lut
-        mapper.SetLookupTable(self._weight_lut)
-        mapper.SetScalarModeToUsePointFieldData()
-        mapper.SelectColorArray("weight")
-        mapper.SetScalarRange(0.0, 1.0)
-        mapper.SetColorModeToMapScalars()
-        mapper.ScalarVisibilityOn()
+            self._weight_lut = mesh_look.weight_lut()
+        mesh_look.color_by_weight(mapper, self._weight_lut)
         self.weights_shown = True
 
     # ------------------------------------------------------------------ proxy
@@ -357,7 +280,7 @@ class RigScene:
         moves the bones only (the mesh keeps its points)."""
         self._model = np.array(model, dtype=float)
         if not self.has_mesh:
-            self._update_bare_skeleton(model)
+            self.bare_skeleton.update(model)
         elif skin and self.proxy_shown:
             self.proxy_actor.skin(skinning_matrices(self.rig.skeleton, model), self._skinning)
         elif skin:
