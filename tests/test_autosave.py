@@ -59,7 +59,7 @@ def test_autosave_writes_after_an_edit_and_not_when_nothing_changed(make_editor,
     np.testing.assert_array_equal(np.array(entry.info["pose"]), doc.pose_snapshot())
     qtbot.wait(500)
     assert auto.writes == 1  # no change since: no rewrite
-    w.timeline.new_clip("stomp")  # a clip edit is a change too
+    w.timeline.clip_manager.new_clip("stomp")  # a clip edit is a change too
     qtbot.waitUntil(lambda: auto.writes == 2, timeout=5000)
     assert _entries()[0].info["clip"] == "stomp"
     # Saved: nothing left to recover, the entry goes at once.
@@ -100,13 +100,13 @@ def test_background_write_keeps_the_state_it_started_from(make_editor, qtbot, mo
         return real(*args, **kwargs)
 
     monkeypatch.setattr(recovery, "write_entry", slow)
-    w.timeline.new_clip("before")  # (a new current clip poses the character from it)
+    w.timeline.clip_manager.new_clip("before")  # (a new current clip poses the character from it)
     doc.set_joint_euler(3, [0, 0, 25])
     first = doc.pose_snapshot()
     assert auto.tick() and auto.busy
     assert not auto.tick()  # one write at a time
     doc.set_joint_euler(3, [0, 0, 50])  # while it writes
-    w.timeline.rename_clip("after")
+    w.timeline.clip_manager.rename_clip("after")
     gate.set()
     qtbot.waitUntil(lambda: auto.writes == 1, timeout=10000)
     [entry] = _entries()
@@ -339,8 +339,8 @@ from rigedit.ui import MainWindow
 def edit():
     w = next(x for x in qapp.topLevelWidgets() if isinstance(x, MainWindow))
     w.document.set_joint_euler(5, [0, 30, 0])
-    w.timeline.new_clip("crash test")
-    w.timeline.insert_key(all_joints=True)
+    w.timeline.clip_manager.new_clip("crash test")
+    w.timeline.keys.insert_key(all_joints=True)
     print("EDITED", json.dumps(w.document.pose_snapshot().tolist()), flush=True)
     if {mode!r} == "raise":
         QtCore.QTimer.singleShot(0, broken)

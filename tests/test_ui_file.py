@@ -117,14 +117,14 @@ def test_open_edit_save_and_save_as_a_rig_folder(qtbot, tmp_path, monkeypatch):
         # edits of what a rig folder keeps: a clip renamed, one deleted, a key, a rest move
         tl = window.timeline
         doc.set_current_clip("nod")
-        tl.rename_clip("bow")
+        tl.clip_manager.rename_clip("bow")
         doc.set_current_clip("wag")
-        tl.delete_clip()
+        tl.clip_manager.delete_clip()
         doc.set_current_clip("bow")
         tl.set_time(0.25)
         doc.select("head")
         doc.set_joint_euler("head", [0, 20, 0])
-        tl.insert_key()                             # K: keys the selected joint
+        tl.keys.insert_key()                             # K: keys the selected joint
         assert set(doc.clips) == {"bow"}
         _no_dialogs(monkeypatch)
         menu_action(window, "File", "Save rig").trigger()
@@ -139,7 +139,7 @@ def test_open_edit_save_and_save_as_a_rig_folder(qtbot, tmp_path, monkeypatch):
         menu_action(window, "File", "Save rig as").trigger()
         assert_same_rig(load_rig_folder(tmp_path / "b"), opened)
         _no_dialogs(monkeypatch)
-        tl.set_duration(2.0)
+        tl.clip_manager.set_duration(2.0)
         menu_action(window, "File", "Save rig").trigger()
         assert load_rig_folder(tmp_path / "b").clips["bow"].duration == 2.0
         assert load_rig_folder(tmp_path / "a").clips["bow"].duration == 1.0

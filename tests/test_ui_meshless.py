@@ -102,7 +102,7 @@ def test_drag_a_joint_key_it_and_play(bvh_window, qtbot):
                                atol=1e-6)
     # key it at 1 s (the drag turned the spine: key all joints), scrub away and back: the
     # keys hold the dragged pose
-    w.timeline.insert_key(all_joints=True)
+    w.timeline.keys.insert_key(all_joints=True)
     w.timeline.set_time(0.0)
     assert np.abs(rig.joint_matrices(doc.pose)[head, :3, 3] - dragged[head]).max() > 0.05
     w.timeline.set_time(1.0)

@@ -93,9 +93,9 @@ def test_clip_deleted_in_the_timeline_is_gone_after_save(window, save_dialog, tm
     tl = window.timeline
     doc = window.document
     doc.set_current_clip("idle")
-    tl.delete_clip()
+    tl.clip_manager.delete_clip()
     doc.set_current_clip("walk")
-    assert tl.rename_clip("stroll") == "stroll"
+    assert tl.clip_manager.rename_clip("stroll") == "stroll"
     trigger(window, "&Save rig")
     assert len(asked) == 1                       # saved in place, no second dialog
     names = sorted(p.name for p in (folder / "animations").iterdir())
@@ -112,7 +112,7 @@ def test_invalid_clip_name_shows_in_the_status_bar_and_changes_nothing(window, b
     tl = window.timeline
     doc.set_current_clip("idle")
     names, depth = list(doc.clips), doc.undo_stack.undo_label
-    assert tl.rename_clip(bad) is None
+    assert tl.clip_manager.rename_clip(bad) is None
     assert list(doc.clips) == names and doc.current_clip == "idle"
     assert doc.undo_stack.undo_label == depth
     message = window.statusBar().currentMessage()

@@ -156,7 +156,7 @@ def test_insert_key_with_k_then_undo(window, qtbot):
 def test_key_all_joints_keys_every_joint(window):
     tl, doc = window.timeline, window.document
     tl.set_time(0.75)
-    tl.insert_key(all_joints=True)
+    tl.keys.insert_key(all_joints=True)
     keyed = {j for (j, c) in tl.clip.tracks if c == "rotation" and 0.75 in tl.clip.key_times(j)}
     assert keyed == set(doc.skeleton.names)
 
@@ -181,7 +181,7 @@ def test_delete_key_and_undo_restore_the_pose(window):
     tl, doc = window.timeline, window.document
     tl.set_time(0.5)
     posed = np.array(window.scene.mesh.points)
-    tl.delete_key(all_joints=True)
+    tl.keys.delete_key(all_joints=True)
     np.testing.assert_allclose(tl.clip.key_times("neck"), [0, 1])
     # the neck now stays at rest between two rest keys: the mesh changed
     assert np.abs(np.array(window.scene.mesh.points) - posed).max() > 0.05
@@ -193,9 +193,9 @@ def test_copy_paste_keys(window):
     tl, doc = window.timeline, window.document
     doc.select("neck")
     tl.set_time(0.5)
-    tl.copy_keys()
+    tl.keys.copy_keys()
     tl.set_time(0.9)
-    tl.paste_keys()
+    tl.keys.paste_keys()
     assert tl.clip.sample(0.9).allclose(tl.clip.sample(0.5))
     assert doc.undo_stack.undo_label.startswith("Paste")
 
@@ -225,7 +225,7 @@ def test_auto_key_writes_keys_when_posing(window):
 def test_interpolation_per_track_with_undo(window):
     tl, doc = window.timeline, window.document
     doc.select("neck")
-    tl.set_interpolation("catmull_rom", "rotation")
+    tl.keys.set_interpolation("catmull_rom", "rotation")
     assert tl.clip.tracks[("neck", "rotation")].interpolation == "catmull_rom"
     assert tl.rot_combo.currentText() == "catmull_rom"
     doc.undo()
@@ -234,19 +234,19 @@ def test_interpolation_per_track_with_undo(window):
 
 def test_clip_new_rename_duplicate_delete_with_undo(window):
     tl, doc = window.timeline, window.document
-    name = tl.new_clip("walk", duration=3.0)
+    name = tl.clip_manager.new_clip("walk", duration=3.0)
     assert doc.current_clip == name == "walk" and tl.clip_combo.currentText() == "walk"
     assert tl.duration_spin.value() == 3.0
-    tl.rename_clip("stride")
+    tl.clip_manager.rename_clip("stride")
     assert "stride" in doc.clips and "walk" not in doc.clips and tl.clip.name == "stride"
-    copy = tl.duplicate_clip()
+    copy = tl.clip_manager.duplicate_clip()
     assert copy == "stride copy" and doc.clips[copy] is not doc.clips["stride"]
-    tl.delete_clip()
+    tl.clip_manager.delete_clip()
     assert copy not in doc.clips
     for _ in range(3):
         doc.undo()
     assert set(doc.clips) == {"nod", "walk"} and doc.clips["walk"].name == "walk"
-    tl.set_duration(2.0)
+    tl.clip_manager.set_duration(2.0)
     assert doc.clips["walk"].duration == 2.0
     doc.undo()
     assert doc.clips["walk"].duration == 3.0

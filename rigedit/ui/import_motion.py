@@ -245,7 +245,7 @@ class ImportMotion:
                                           f"retargeted; import it again")
             return None
         clip = res.clip
-        added = self.w.timeline.add_clip(clip, ctx.base, f"Import motion {path.name}")
+        added = self.w.timeline.clip_manager.add_clip(clip, ctx.base, f"Import motion {path.name}")
         if added is None:
             return None
         self.w.status(f"Imported {path.name} as clip {added!r} ({clip.duration:.2f} s): "
