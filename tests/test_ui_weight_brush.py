@@ -246,12 +246,12 @@ def test_brush_circle_follows_the_mouse_over_the_mesh_and_hides_when_it_leaves(d
     w = demo_window
     d = w.document
     start_brush(w, 4, radius=30)
-    circle = w.weight_brush.circle_actor
+    circle = w.weight_brush.circle.actor
     xy = np.round(display(w, d.skeleton.bind_matrices[4, :3, 3]))
     qt = QtCore.QPoint(int(xy[0]), int(w.plotter.height() - 1 - xy[1]))
     qtbot.mouseMove(w.plotter, qt)  # no button held: hovering
     assert circle.GetVisibility()
-    pts = np.array([w.weight_brush.circle.GetPoint(k) for k in range(64)])[:, :2]
+    pts = np.array([w.weight_brush.circle.polydata.GetPoint(k) for k in range(64)])[:, :2]
     np.testing.assert_allclose(pts.mean(axis=0), xy, atol=0.5)
     np.testing.assert_allclose(np.linalg.norm(pts - xy, axis=1), 30, atol=1e-4)  # float32
     assert len(d.undo_stack) == 0  # hovering paints nothing

@@ -12,25 +12,22 @@ plain click (no drag) in the weight paint view while the brush is off.
 The press, move and release observers sit on the VTK interactor at a priority between the
 axis handles' and the joint spheres' and abort the events they take, so the camera does not
 turn while painting; a press that misses the mesh or lands on a joint sphere goes on to the
-spheres and the camera as before.
+spheres and the camera as before. The brush's outline is :mod:`rigedit.render.brush_circle`'s,
+the mouse ray against the surface :mod:`rigedit.render.surface_pick`'s.
 """
 from __future__ import annotations
 
 import numpy as np
-import vtk
 from PyQt5 import QtWidgets
 
-from ..model.weight_paint import (brush_vertices, joint_column, mirror_vertices, paint,
-                                  paint_mirrored, vertex_adjacency)
+from ..model.weight_paint import mirror_vertices, vertex_adjacency
+from ..render.brush_circle import BrushCircle
 from ..render.observers import add_mouse_observers
-from ..render.ray import display_to_world, world_to_display
+from ..render.surface_pick import SurfacePicker, nearest_vertex, world_radius
 from .brush_panel import BrushPanel
+from .weight_stroke import WeightStroke
 
 __all__ = ["BrushPanel", "WeightBrush", "install_weight_brush"]
-
-CIRCLE_SEGMENTS = 64
-CIRCLE_COLOR = (1.0, 1.0, 1.0)
-CIRCLE_OFF_MESH = (0.6, 0.6, 0.6)
 
 
 class WeightBrush:
@@ -41,10 +38,12 @@ class WeightBrush:
     enabled : bool
     locked : set of int
         Joints whose weights painting must not change.
-    stroke : dict or None
-        The stroke under way: working ``indices`` and ``weights`` (V, K) and the ``joint``.
+    stroke : WeightStroke or None
+        The stroke under way.
     errors : list of str
         Tracebacks of exceptions raised in the mouse callbacks (each also shown).
+    circle : BrushCircle
+        The brush's outline under the mouse.
     """
 
     PRIORITY = 9.0  # below the axis handles (10), above the joint spheres (0.5) and camera
@@ -57,7 +56,8 @@ class WeightBrush:
         self.stroke = None
         self._cache = {}
         self._click = None  # (x, y, vertex) of a press that may become a plain click
-        self._build_circle()
+        self.circle = BrushCircle()
+        self._picker = SurfacePicker()
         iren = window.plotter.iren.interactor
         self._iren = iren
         self.errors = []  # tracebacks of failed callbacks (see :meth:`on_error`)
@@ -73,31 +73,12 @@ class WeightBrush:
         self._attach()
 
     # ------------------------------------------------------------------ scene
-    def _build_circle(self):
-        """A 2D polyline actor in display pixels, moved to the mouse at each event."""
-        self.circle = vtk.vtkPolyData()
-        pts = vtk.vtkPoints()
-        pts.SetNumberOfPoints(CIRCLE_SEGMENTS)
-        self.circle.SetPoints(pts)
-        line = vtk.vtkCellArray()
-        line.InsertNextCell(CIRCLE_SEGMENTS + 1)
-        for k in range(CIRCLE_SEGMENTS + 1):
-            line.InsertCellPoint(k % CIRCLE_SEGMENTS)
-        self.circle.SetLines(line)
-        mapper = vtk.vtkPolyDataMapper2D()
-        mapper.SetInputData(self.circle)
-        self.circle_actor = vtk.vtkActor2D()
-        self.circle_actor.SetMapper(mapper)
-        self.circle_actor.GetProperty().SetLineWidth(2.0)
-        self.circle_actor.GetProperty().SetColor(*CIRCLE_COLOR)
-        self.circle_actor.VisibilityOff()
-
     def _attach(self):
         """Put the circle into the overlay renderer (rebuilt when a rig is opened)."""
         overlay = getattr(self.w, "overlay", None) or self.w.plotter.renderer
-        if not overlay.HasViewProp(self.circle_actor):
-            overlay.AddViewProp(self.circle_actor)
-        self._locator_stamp = None
+        if not overlay.HasViewProp(self.circle.actor):
+            overlay.AddViewProp(self.circle.actor)
+        self._picker.reset()
         self._cache = {}
 
     def _on_document(self, event, **info):
@@ -124,7 +105,7 @@ class WeightBrush:
             self.w.set_weights_view(True)
         if not on:
             self.cancel()
-            self.circle_actor.VisibilityOff()
+            self.circle.actor.VisibilityOff()
         self.w.status("Weight brush: drag on the mesh to paint the selected joint; "
                       "Ctrl+click shows a vertex's influences" if on else "Weight brush off")
         self.w.request_render()
@@ -181,9 +162,7 @@ class WeightBrush:
         if j in self.locked:
             self.w.status(f"{d.skeleton.names[j]} is locked: unlock it to paint it")
             return True
-        b = d.rig.binding
-        self.stroke = {"joint": j, "indices": b.indices.copy(), "weights": b.weights.copy(),
-                       "rig": d.rig, "binding": b, "dabs": 0}
+        self.stroke = WeightStroke(d, j)
         self.dab(hit, x, y)
         return True
 
@@ -208,8 +187,8 @@ class WeightBrush:
 
     def _leave(self, _iren, _event):
         """The mouse left the view: no circle where it no longer is."""
-        if self.circle_actor.GetVisibility():
-            self.circle_actor.VisibilityOff()
+        if self.circle.actor.GetVisibility():
+            self.circle.actor.VisibilityOff()
             self.w.request_render()
 
     def _click_release(self, iren, _event):
@@ -225,36 +204,11 @@ class WeightBrush:
 
     # ------------------------------------------------------------------ picking
     def pick(self, x, y):
-        """The point of the shown mesh under display pixel (x, y), or None: the first
-        crossing of the mouse ray with the skinned surface, found with a cell locator
-        (a vtkCellPicker tested every triangle: 44 ms a pick on the 60k-triangle quadruped,
-        measured)."""
-        ren = self.w.plotter.renderer
-        if self.w.scene.mesh_actor is None or not ren.IsInViewport(int(x), int(y)):
+        """The point of the shown mesh under display pixel (x, y), or None
+        (:meth:`SurfacePicker.pick <rigedit.render.surface_pick.SurfacePicker.pick>`)."""
+        if self.w.scene.mesh_actor is None:
             return None
-        locator = self._current_locator()
-        if locator is None:
-            return None
-        ends = [display_to_world(ren, x, y, z) for z in (0.0, 1.0)]
-        t, sub, cell = vtk.reference(0.0), vtk.reference(0), vtk.reference(0)
-        hit, pcoords = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
-        if not locator.IntersectWithLine(ends[0], ends[1], 0.0, t, hit, pcoords, sub, cell):
-            return None
-        return np.array(hit)
-
-    def _current_locator(self):
-        """The cell locator of the shown mesh, rebuilt when its points moved (a new pose;
-        about 16 ms on the quadruped), not when only its colours changed."""
-        mesh = self.w.scene.mesh
-        if mesh.n_cells == 0:
-            return None
-        stamp = (id(mesh), mesh.GetPoints().GetMTime())
-        if getattr(self, "_locator_stamp", None) != stamp:
-            self._locator = vtk.vtkStaticCellLocator()
-            self._locator.SetDataSet(mesh)
-            self._locator.BuildLocator()
-            self._locator_stamp = stamp
-        return self._locator
+        return self._picker.pick(self.w.plotter.renderer, self.w.scene.mesh, x, y)
 
     def _sphere_under(self, x, y):
         """Whether a visible joint sphere is under the mouse (the spheres stay clickable)."""
@@ -263,24 +217,13 @@ class WeightBrush:
 
     def world_radius(self, point, pixels):
         """Scene units that ``pixels`` span on screen at the depth of ``point``."""
-        ren = self.w.plotter.renderer
-        dx, dy, dz = world_to_display(ren, point)
-        return float(np.linalg.norm(display_to_world(ren, dx + float(pixels), dy, dz) - point))
+        return world_radius(self.w.plotter.renderer, point, pixels)
 
     def nearest_vertex(self, point):
-        pts = np.asarray(self.w.scene.mesh.points)
-        return int(np.argmin(np.einsum("ij,ij->i", pts - point, pts - point)))
+        return nearest_vertex(self.w.scene.mesh.points, point)
 
     def _show_circle(self, x, y, on_mesh):
-        r = self.panel.radius_box.value()
-        a = np.linspace(0.0, 2.0 * np.pi, CIRCLE_SEGMENTS, endpoint=False)
-        pts = self.circle.GetPoints()
-        for k in range(CIRCLE_SEGMENTS):
-            pts.SetPoint(k, x + r * np.cos(a[k]), y + r * np.sin(a[k]), 0.0)
-        pts.Modified()
-        self.circle.Modified()
-        self.circle_actor.GetProperty().SetColor(*(CIRCLE_COLOR if on_mesh else CIRCLE_OFF_MESH))
-        self.circle_actor.VisibilityOn()
+        self.circle.show(x, y, self.panel.radius_box.value(), on_mesh)
         self.w.request_render()
 
     # ------------------------------------------------------------------ painting
@@ -301,27 +244,20 @@ class WeightBrush:
         self._show_circle(x, y, True)
         if not radius > 0:
             return
-        verts, factors = brush_vertices(np.asarray(self.w.scene.mesh.points), point, radius)
-        if len(verts) == 0:
-            return
-        j = s["joint"]
-        sk = d.skeleton
-        options = dict(mode=p.mode, strength=p.strength_box.value(), value=p.value_box.value(),
-                       locked=sorted(self.locked), fallback=int(sk.parents[j]))
+        adjacency = mirror = None
         if p.mode == "smooth":
-            options["adjacency"] = self._rig_cache(
+            adjacency = self._rig_cache(
                 "adjacency", lambda rig: vertex_adjacency(rig.faces, len(rig.vertices)))
-        args = (s["indices"], s["weights"], len(sk), j, verts, factors)
         if p.mirror_box.isChecked():
             axis = d._side_axis()
             mirror = self._rig_cache(("mirror", axis),
                                      lambda rig: mirror_vertices(rig.vertices, axis))
-            s["indices"], s["weights"] = paint_mirrored(*args, mirror, d.mirror, **options)
-        else:
-            s["indices"], s["weights"] = paint(*args, **options)
-        s["dabs"] += 1
+        if not s.dab(np.asarray(self.w.scene.mesh.points), point, radius, p.mode,
+                     p.strength_box.value(), p.value_box.value(), self.locked, adjacency,
+                     mirror):
+            return
         if self.w.weights_view:
-            self.w.scene.show_weights(joint_column(s["indices"], s["weights"], j))
+            self.w.scene.show_weights(s.column())
         self.w.request_render()
 
     def finish(self):
@@ -329,16 +265,9 @@ class WeightBrush:
         s, self.stroke = self.stroke, None
         if s is None:
             return
-        d = self.w.document
-        if d.rig is not s["rig"] or d.rig.binding is not s["binding"]:
-            self.w.status("Stroke dropped: the weights changed while painting")
-            return
-        b = s["binding"]
-        if np.array_equal(s["indices"], b.indices) and np.array_equal(s["weights"], b.weights):
-            return
-        name = d.skeleton.names[s["joint"]]
-        d.set_weights(s["indices"], s["weights"], label=f"Paint {name}")
-        self.w.status(f"Painted {name} ({s['dabs']} dabs); Ctrl+Z undoes the stroke")
+        message = s.commit()
+        if message is not None:
+            self.w.status(message)
 
     def cancel(self):
         """Drop a stroke under way (the shown colours go back to the document's)."""
