@@ -41,6 +41,7 @@ from rigedit.model.skinning import top_k_influences
 
 J, K = 40, 4
 BYTES_PER_VERTEX = 12 + 4 * K + 4 * K + 12  # rest, indices, weights, output
+BYTES_WITH_NORMALS = BYTES_PER_VERTEX + 24  # and the rest normals in, the normals out
 
 
 def timed_ms(fn, repeat):
@@ -106,7 +107,8 @@ def main(repeat_scale=1.0):
     print("random weights (4 non-zero influences):")
     print(f"{'vertices':>9} | " + " | ".join(f"{c:>13}" for c in cols)
           + f" | {'LBS1/floor':>13} | {'DQS1/LBS1':>13}")
-    cpu_cols = ["floor", "LBS 1t", "LBS numpy", "dense ref", "DQS 1t", "DQS numpy"]
+    cpu_cols = ["floor", "LBS 1t", "LBS numpy", "dense ref", "DQS 1t", "DQS numpy", "floor+n",
+                "LBS+n 1t", "DQS+n 1t"]
     cpu_rows = []
     cases = [(v, "random") for v in (10_000, 100_000, 1_000_000)]
     cases += [(v, "quadruped") for v in (10_000, 100_000, 1_000_000)]
@@ -137,7 +139,10 @@ def main(repeat_scale=1.0):
         ref_dqs = binding.skin(p0, method="dqs", backend="numpy").copy()
         assert np.allclose(binding.skin(p0, method="dqs", backend="numba"), ref_dqs, atol=1e-4)
         repeat = max(3, int(repeat_scale * (200 if v <= 10_000 else 60 if v <= 100_000 else 15)))
-        row = {"floor": tuple(v * BYTES_PER_VERTEX / (b * 1e9) * 1e3 for b in bw)}
+        row = {"floor": tuple(v * BYTES_PER_VERTEX / (b * 1e9) * 1e3 for b in bw),
+               "floor+n": tuple(v * BYTES_WITH_NORMALS / (b * 1e9) * 1e3 for b in bw)}
+        normals = rng.normal(size=(v, 3))
+        binding.bind_normals(normals / np.linalg.norm(normals, axis=1, keepdims=True))
         binding.threads = None
         binding.skin(pals[0], backend="numba")  # the output buffer's pages are mapped
         for threads in (1, 2):
@@ -146,6 +151,11 @@ def main(repeat_scale=1.0):
                                              repeat)
             row[f"DQS {threads}t"] = timed_ms(
                 lambda: binding.skin(palette(), method="dqs", backend="numba"), repeat)
+        binding.threads = 1
+        for method in ("lbs", "dqs"):
+            row[f"{method.upper()}+n 1t"] = timed_ms(
+                lambda: binding.skin_with_normals(palette(), backend="numba", method=method),
+                repeat)
         row["LBS numpy"] = timed_ms(lambda: binding.skin(palette(), backend="numpy"), repeat)
         row["dense ref"] = timed_ms(dense_frame, max(3, repeat // 4))
         row["DQS numpy"] = timed_ms(
@@ -156,14 +166,16 @@ def main(repeat_scale=1.0):
               + " | " + " | ".join(f"{r[0]:>5.2f} ({r[1]:.2f})".rjust(13) for r in ratios),
               flush=True)
         cpu_rows.append((v, kind, row))
-    print("\nbest CPU time of the calling thread, ms per frame (one thread only):")
+    print("\nbest CPU time of the calling thread, ms per frame (one thread only; +n: positions "
+          f"and normals in one pass, against a floor of {BYTES_WITH_NORMALS} bytes/vertex):")
     print(f"{'vertices':>9} | {'weights':>9} | " + " | ".join(f"{c:>9}" for c in cpu_cols)
-          + f" | {'LBS1/floor':>10} | {'DQS1/floor':>10} | {'DQS1/LBS1':>9}")
+          + f" | {'LBS1/floor':>10} | {'DQS1/floor':>10} | {'DQS1/LBS1':>9} | {'DQS+n/fl+n':>10}")
     for v, kind, row in cpu_rows:
         print(f"{v:>9,} | {kind:>9} | " + " | ".join(f"{row[c][2]:>9.3f}" for c in cpu_cols)
               + f" | {row['LBS 1t'][2] / row['floor'][2]:>10.2f}"
               + f" | {row['DQS 1t'][2] / row['floor'][2]:>10.2f}"
-              + f" | {row['DQS 1t'][2] / row['LBS 1t'][2]:>9.2f}")
+              + f" | {row['DQS 1t'][2] / row['LBS 1t'][2]:>9.2f}"
+              + f" | {row['DQS+n 1t'][2] / row['floor+n'][2]:>10.2f}")
 
 
 if __name__ == "__main__":

@@ -177,14 +177,22 @@ def test_vector_kernel_refuses_a_palette_it_would_read_past():
 @pytest.mark.parametrize("scale", [False, True])
 def test_dqs_kernel_blocks_and_their_remainders_agree_with_numpy(v, scale):
     """The DQS kernel transforms 16 vertices at a time in tasks of DQS_TASK vertices; counts
-    around those sizes take the one-vertex path for a task's last few, and every vertex must
-    be written (the output starts as NaN)."""
+    around those sizes take the one-vertex path for the last few, and every vertex must be
+    written (the outputs start as NaN), positions alone or with normals."""
     assert skinning_kernels.DQS_TASK == 1024
     binding = random_binding(v, 12, 8, seed=v)
     pal = random_palette(12, seed=v, scale=scale)
     ref = binding.skin(pal, method="dqs", backend="numpy").copy()
+    rest_normals = np.random.default_rng(v).normal(size=(v, 3))
+    rest_normals /= np.linalg.norm(rest_normals, axis=1, keepdims=True)
+    binding.bind_normals(rest_normals)
+    ref_normals = binding.skin_with_normals(pal, method="dqs", backend="numpy")[1].copy()
     for threads in (1, 2):
         binding.threads = threads
         out = np.full((v, 3), np.nan, np.float32)
         binding.skin(pal, method="dqs", out=out, backend="numba")
         assert np.abs(out - ref).max() <= 4e-6 * max(1.0, np.abs(ref).max())
+        binding._out[:] = binding._out_normals[:] = np.nan
+        verts, normals = binding.skin_with_normals(pal, method="dqs", backend="numba")
+        assert np.abs(verts - ref).max() <= 4e-6 * max(1.0, np.abs(ref).max())
+        assert np.abs(normals - ref_normals).max() <= 4e-6

@@ -103,7 +103,7 @@ def palette_dual_quaternions(palette, tol=1e-6):
     return np.concatenate([qr, qd], axis=1), scale, not rigid
 
 
-def dqs_skin(rest, indices, weights, dq, scale=None):
+def dqs_skin(rest, indices, weights, dq, scale=None, rest_normals=None):
     """Dual-quaternion skinning of every vertex (numpy reference).
 
     Parameters
@@ -119,21 +119,28 @@ def dqs_skin(rest, indices, weights, dq, scale=None):
     scale : (J, 3, 3) float, optional
         Scale/shear matrices, blended linearly and applied to the rest point first; None for
         rigid motion only.
+    rest_normals : (V, 3) float, optional
+        Unit rest normals, turned by each vertex's blended rotation (after its blended
+        scale/shear, as the points) and renormalised.
 
     Returns
     -------
     vertices : (V, 3) float64
+    normals : (V, 3) float64
+        Only when ``rest_normals`` is given.
     """
     rest = np.asarray(rest, dtype=np.float64)
     weights = np.asarray(weights, dtype=np.float64)
     indices = np.asarray(indices)
     if len(rest) == 0:  # a rig without a mesh (a BVH skeleton)
-        return np.zeros((0, 3))
+        return np.zeros((0, 3)) if rest_normals is None else (np.zeros((0, 3)),) * 2
     q = np.asarray(dq, dtype=np.float64)[indices]  # (V, K, 8)
     p = rest
+    n = None if rest_normals is None else np.asarray(rest_normals, dtype=np.float64)
     if scale is not None:
         blended = np.einsum("vk,vkij->vij", weights, np.asarray(scale, np.float64)[indices])
         p = np.einsum("vij,vj->vi", blended, rest)
+        n = None if n is None else np.einsum("vij,vj->vi", blended, n)
     # Antipodality: q and -q are the same rotation; flip every influence into the hemisphere
     # of the strongest one so the blend takes the short way.
     pivot = q[np.arange(len(q)), np.argmax(weights, axis=1), :4]
@@ -142,5 +149,10 @@ def dqs_skin(rest, indices, weights, dq, scale=None):
     b /= np.linalg.norm(b[:, :4], axis=1, keepdims=True)
     r, w, d, e = b[:, :3], b[:, 3:4], b[:, 4:7], b[:, 7:8]
     # p' = p + 2 r × (r × p + w p) + 2 (w d − e r + r × d)
-    return (p + 2.0 * np.cross(r, np.cross(r, p) + w * p)
-            + 2.0 * (w * d - e * r + np.cross(r, d)))
+    moved = (p + 2.0 * np.cross(r, np.cross(r, p) + w * p)
+             + 2.0 * (w * d - e * r + np.cross(r, d)))
+    if n is None:
+        return moved
+    n = n + 2.0 * np.cross(r, np.cross(r, n) + w * n)
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    return moved, np.divide(n, length, out=np.zeros_like(n), where=length > 0)

@@ -167,6 +167,7 @@ class SkinBinding:
         self._signs = np.empty((self.num_joints, self.num_joints), dtype=np.float32)
         self._rest_normals32 = None  # set by bind_normals
         self._out_normals = None
+        self._no_normals = np.empty((0, 3), dtype=np.float32)  # the DQS kernel without normals
         #: Threads of the compiled kernels: None picks one for small meshes, all for big ones
         #: (see ``skinning_kernels.PARALLEL_MIN_VERTICES``).
         self.threads = None
@@ -264,15 +265,18 @@ class SkinBinding:
         self._rest_normals32 = np.ascontiguousarray(n, dtype=np.float32)
         self._out_normals = np.empty_like(self._rest_normals32)
 
-    def skin_with_normals(self, palette, backend=None):
-        """LBS vertex positions and normals in one pass: each vertex's blended 3x3 applied to
+    def skin_with_normals(self, palette, backend=None, method="lbs"):
+        """Vertex positions and normals in one pass. LBS: each vertex's blended 3x3 applied to
         its rest normal, renormalised (exact for rotations and uniform scale, as shading
-        needs; not the inverse transpose under non-uniform scale). Needs :meth:`bind_normals`.
+        needs; not the inverse transpose under non-uniform scale). DQS: the rest normal turned
+        by the vertex's blended rotation (after its blended scale/shear, when the palette has
+        any), renormalised. Needs :meth:`bind_normals`.
 
         Parameters
         ----------
         palette : (J, 4, 4) float
         backend : {None, "numba", "numpy"}
+        method : {"lbs", "dqs"}
 
         Returns
         -------
@@ -281,8 +285,19 @@ class SkinBinding:
         """
         if self._rest_normals32 is None:
             raise ValueError("no rest normals: call bind_normals first")
+        if method not in METHODS:
+            raise ValueError(f"expected a skinning method in {METHODS}, got {method!r}")
         kernels = self._kernels(backend)
         res, nrm = self._out, self._out_normals
+        if method == "dqs":
+            if kernels is not None:
+                self._run_dqs(kernels, palette, self._rest_normals32, res, nrm)
+            else:
+                dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
+                res[:], nrm[:] = dqs_skin(self.rest_vertices, self.indices, self.weights, dq,
+                                          scale if has_scale else None,
+                                          rest_normals=self._rest_normals32)
+            return res, nrm
         if kernels is not None:
             self._palette16.reshape(-1, 4, 4)[:] = np.asarray(palette).transpose(0, 2, 1)
             kernels.run("lbs_normals", len(res), self.threads, self._rest32,
@@ -316,23 +331,29 @@ class SkinBinding:
         kernels = self._kernels(backend)
         res = self._output(out)
         if kernels is not None and res.dtype == np.float32 and res.flags.c_contiguous:
-            palette = np.ascontiguousarray(palette, dtype=np.float64)
-            if palette.shape != (self.num_joints, 4, 4):  # the kernel writes J rows of _dq
-                raise ValueError(f"expected a palette of shape ({self.num_joints}, 4, 4), got "
-                                 f"{palette.shape}")
-            has_scale = not kernels.rigid_dual_quaternions(palette, DQS_RIGID_TOL, self._dq)
-            if has_scale:
-                dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
-                self._dq[:] = dq
-                self._scale[:] = scale.reshape(-1, 9)
-            skinning_kernels.hemisphere_signs(self._dq, self._signs)
-            kernels.run("dqs", len(res), self.threads, self._rest32, self._indices32,
-                        self._weights32, self._dq, self._signs, self._scale, has_scale, res)
+            self._run_dqs(kernels, palette, self._no_normals, res, self._no_normals)
             return res
         dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
         res[:] = dqs_skin(self.rest_vertices, self.indices, self.weights, dq,
                           scale if has_scale else None)
         return res
+
+    def _run_dqs(self, kernels, palette, rest_normals, out, out_normals):
+        """The compiled DQS kernel: positions into ``out``, normals too unless
+        ``out_normals`` has no rows."""
+        palette = np.ascontiguousarray(palette, dtype=np.float64)
+        if palette.shape != (self.num_joints, 4, 4):  # the kernel writes J rows of _dq
+            raise ValueError(f"expected a palette of shape ({self.num_joints}, 4, 4), got "
+                             f"{palette.shape}")
+        has_scale = not kernels.rigid_dual_quaternions(palette, DQS_RIGID_TOL, self._dq)
+        if has_scale:
+            dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
+            self._dq[:] = dq
+            self._scale[:] = scale.reshape(-1, 9)
+        skinning_kernels.hemisphere_signs(self._dq, self._signs)
+        kernels.run("dqs", len(out), self.threads, self._rest32, rest_normals,
+                    self._indices32, self._weights32, self._dq, self._signs, self._scale,
+                    has_scale, out, out_normals)
 
 
 def linear_blend_skin(binding, palette, out=None):

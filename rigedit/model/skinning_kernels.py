@@ -30,8 +30,11 @@ import threading
 
 import numpy as np
 
+from . import dqs_kernels
+from .dqs_kernels import DQS_TASK, hemisphere_signs
+
 __all__ = ["ready", "load", "start_loading", "disabled", "error", "Kernels", "DISABLE_ENV",
-           "PARALLEL_MIN_VERTICES", "AUTO_LOAD_MIN_VERTICES"]
+           "PARALLEL_MIN_VERTICES", "AUTO_LOAD_MIN_VERTICES", "DQS_TASK", "hemisphere_signs"]
 
 #: A binding this big starts loading the kernels by itself (see the module's notes).
 AUTO_LOAD_MIN_VERTICES = 50_000
@@ -44,9 +47,7 @@ FASTMATH = {"contract", "reassoc", "nsz", "arcp"}
 # Replaced before compiling (numba reads module globals): numba.prange, and the vector blends
 # of skinning_simd (which imports numba, so it is imported only then).
 prange = range
-_blend_apply4 = _blend_apply4_normal = _dq_blend4_into = _dq_apply16 = _check_groups = None
-_dq_blend_block = _scale_block = _dq_apply_one = _dqs_rigid_task = _dqs_scaled_task = None
-
+_blend_apply4 = _blend_apply4_normal = _check_groups = None
 
 def _check_groups_py(indices, palette):
     """The vector blends read 16 floats per palette row and influences four at a time."""
@@ -128,251 +129,36 @@ def _lbs_normals_py(rest, rest_normals, indices, weights, palette, out, out_norm
         out_normals[v, 2] = c * inv
 
 
-#: Vertices per parallel task of the DQS kernel (a multiple of skinning_simd.DQ_BLOCK): each
-#: task allocates its two small scratch blocks once.
-DQS_TASK = 1024
-
-
-def _dqs_py(rest, indices, weights, dq, signs, scale, has_scale, out):
-    """Dual-quaternion skinning of every vertex (Kavan et al. 2008).
-
-    dq (J, 8) f32: each joint's rigid part as a unit dual quaternion, real (x, y, z, w) then
-    dual (x, y, z, w); signs (J, J) f32: -1 where two joints' quaternions point into opposite
-    hemispheres, else 1 (:func:`hemisphere_signs`); scale (J, 9) f32: each joint's
-    scale/shear part (row-major 3x3), blended linearly and applied to the rest point first
-    when ``has_scale``. Each influence's quaternion is flipped into the hemisphere of the
-    vertex's strongest influence (the first: influences sorted, padded to groups of four as
-    for :func:`_lbs_py`).
-
-    Two steps per block of 16 vertices (``DQ_BLOCK``): each vertex's blend of four influences
-    is one 8-float vector operation (:func:`.skinning_simd.dq_blend4_into`) stored into a
-    16 x 8 scratch block; then :func:`.skinning_simd.dq_apply16` transforms the 16 points at
-    once, a 16-float vector per coordinate. Done per vertex in scalar code, that transform
-    (50-odd operations) cost more than the blend and the memory traffic together (0.63 ms
-    against 0.26 for the blend alone at 100k vertices). The rigid case reads the rest points
-    directly; with scale the blended scale/shear is applied first into a 16 x 3 block. The
-    last n % 16 vertices are transformed one at a time (:func:`_dq_apply_one_py`) after the
-    parallel loop: a scalar path inside it slowed every block down.
-    """
-    if (dq.shape[1] != 8 or indices.shape[1] % 4 != 0 or signs.shape[0] != dq.shape[0]
-            or signs.shape[1] != dq.shape[0]):
-        raise ValueError("expected dual quaternions of 8 floats, a (J, J) sign table and "
-                         "influences in groups of 4")
-    n = indices.shape[0]
-    whole = n - n % 16
-    tasks = (whole + DQS_TASK - 1) // DQS_TASK
-    # Two loops rather than one testing has_scale per block: with the scale path in the
-    # loop, the rigid case measured 25% slower (0.30 -> 0.38 ms at 100k vertices).
-    if has_scale:
-        for task in prange(tasks):
-            _dqs_scaled_task(rest, indices, weights, dq, signs, scale, out, task * DQS_TASK,
-                             min(whole, (task + 1) * DQS_TASK))
-    else:
-        for task in prange(tasks):
-            _dqs_rigid_task(rest, indices, weights, dq, signs, out, task * DQS_TASK,
-                            min(whole, (task + 1) * DQS_TASK))
-    if whole < n:
-        count = n - whole
-        blend = np.empty((16, 8), np.float32)
-        points = rest
-        p0 = whole
-        if has_scale:
-            points = np.empty((16, 3), np.float32)
-            p0 = 0
-            _scale_block(rest, indices, weights, scale, whole, count, points)
-        _dq_blend_block(indices, weights, dq, signs, whole, count, blend)
-        for i in range(count):
-            _dq_apply_one(blend, i, points, p0 + i, out, whole + i)
-
-
-def _dqs_rigid_task_py(rest, indices, weights, dq, signs, out, start, stop):
-    """:func:`_dqs_py` of the vertices start to stop (whole blocks of 16), no scale."""
-    blend = np.empty((16, 8), np.float32)
-    for first in range(start, stop, 16):
-        _dq_blend_block(indices, weights, dq, signs, first, 16, blend)
-        _dq_apply16(blend, rest, first, out, first)
-
-
-def _dqs_scaled_task_py(rest, indices, weights, dq, signs, scale, out, start, stop):
-    """:func:`_dqs_py` of the vertices start to stop (whole blocks of 16), with scale."""
-    blend = np.empty((16, 8), np.float32)
-    scaled = np.empty((16, 3), np.float32)
-    for first in range(start, stop, 16):
-        _dq_blend_block(indices, weights, dq, signs, first, 16, blend)
-        _scale_block(rest, indices, weights, scale, first, 16, scaled)
-        _dq_apply16(blend, scaled, 0, out, first)
-
-
-def _dq_blend_block_py(indices, weights, dq, signs, first, count, blend):
-    """blend[i] = the blend of vertex first + i's influences, for i < count."""
-    for i in range(count):
-        # Unsigned: numba then indexes without its negative-index wraparound, which
-        # measured 25% of this kernel's time (0.40 -> 0.30 ms at 100k vertices).
-        v = np.uint64(first + i)
-        # the strongest influence (the first: sorted) fixes the blend's hemisphere
-        jp = indices[v, 0]
-        _dq_blend4_into(dq, signs, jp, indices[v, 0], indices[v, 1], indices[v, 2],
-                        indices[v, 3], weights[v, 0], weights[v, 1], weights[v, 2],
-                        weights[v, 3], blend, i, False)
-        for g in range(4, indices.shape[1], 4):
-            if weights[v, g] == 0.0:  # sorted: the rest are zero too
-                break
-            _dq_blend4_into(dq, signs, jp, indices[v, g], indices[v, g + 1],
-                            indices[v, g + 2], indices[v, g + 3], weights[v, g],
-                            weights[v, g + 1], weights[v, g + 2], weights[v, g + 3],
-                            blend, i, True)
-
-
-def _scale_block_py(rest, indices, weights, scale, first, count, scaled):
-    """scaled[i] = (sum_k w_k S_jk) rest[first + i] for i < count: the first phase of DQS
-    with scale."""
-    for i in range(count):
-        v = np.uint64(first + i)
-        s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = s8 = np.float32(0.0)
-        for k in range(indices.shape[1]):
-            w = weights[v, k]
-            if w == 0.0:
-                break
-            j = indices[v, k]
-            s0 += w * scale[j, 0]
-            s1 += w * scale[j, 1]
-            s2 += w * scale[j, 2]
-            s3 += w * scale[j, 3]
-            s4 += w * scale[j, 4]
-            s5 += w * scale[j, 5]
-            s6 += w * scale[j, 6]
-            s7 += w * scale[j, 7]
-            s8 += w * scale[j, 8]
-        x, y, z = rest[v, 0], rest[v, 1], rest[v, 2]
-        scaled[i, 0] = s0 * x + s1 * y + s2 * z
-        scaled[i, 1] = s3 * x + s4 * y + s5 * z
-        scaled[i, 2] = s6 * x + s7 * y + s8 * z
-
-
-def _dq_apply_one_py(blend, i, points, p, out, v):
-    """out[v] = points[p] moved by the blend in row i: :func:`.skinning_simd.dq_apply16`'s
-    formula for one vertex (the end of a task that is not a whole block)."""
-    b0, b1, b2, b3 = blend[i, 0], blend[i, 1], blend[i, 2], blend[i, 3]
-    e0, e1, e2, e3 = blend[i, 4], blend[i, 5], blend[i, 6], blend[i, 7]
-    x, y, z = points[p, 0], points[p, 1], points[p, 2]
-    two = np.float32(2.0) / (b0 * b0 + b1 * b1 + b2 * b2 + b3 * b3)
-    cx = b1 * z - b2 * y + b3 * x
-    cy = b2 * x - b0 * z + b3 * y
-    cz = b0 * y - b1 * x + b3 * z
-    tx = b3 * e0 - e3 * b0 + b1 * e2 - b2 * e1
-    ty = b3 * e1 - e3 * b1 + b2 * e0 - b0 * e2
-    tz = b3 * e2 - e3 * b2 + b0 * e1 - b1 * e0
-    out[v, 0] = x + two * (b1 * cz - b2 * cy + tx)
-    out[v, 1] = y + two * (b2 * cx - b0 * cz + ty)
-    out[v, 2] = z + two * (b0 * cy - b1 * cx + tz)
-
-
 #: Below this many vertices a frame runs on one thread: waking a second one costs more than it
 #: saves there, and on a busy machine a parallel call waits for its slowest thread.
 PARALLEL_MIN_VERTICES = 100_000
 
 
-def _rigid_dual_quaternions_py(palette, tol, dq):
-    """Each skinning matrix as a unit dual quaternion into ``dq`` (J, 8) f32, when every one is
-    rigid: returns False (``dq`` unspecified) as soon as one's 3x3 ``A`` has ``AᵀA`` further
-    than ``tol`` from the identity or a negative determinant; the caller then takes the numpy
-    path of :func:`rigedit.model.dqs.palette_dual_quaternions`, which handles scale.
-
-    palette (J, 4, 4) f64. The per-frame conversion in numpy costs 0.1-0.5 ms for 40 joints
-    (tens of small array operations), as much as the kernel for 10k vertices; here about 1 us.
-    """
-    for j in range(palette.shape[0]):
-        m = palette[j]
-        for r in range(3):
-            for c in range(3):
-                g = m[0, r] * m[0, c] + m[1, r] * m[1, c] + m[2, r] * m[2, c]
-                if abs(g - (1.0 if r == c else 0.0)) > tol:
-                    return False
-        det = (m[0, 0] * (m[1, 1] * m[2, 2] - m[1, 2] * m[2, 1])
-               - m[0, 1] * (m[1, 0] * m[2, 2] - m[1, 2] * m[2, 0])
-               + m[0, 2] * (m[1, 0] * m[2, 1] - m[1, 1] * m[2, 0]))
-        if det <= 0.0:
-            return False
-        # Shepperd: start from the largest of 4w^2, 4x^2, 4y^2, 4z^2
-        tr = m[0, 0] + m[1, 1] + m[2, 2]
-        if tr >= m[0, 0] and tr >= m[1, 1] and tr >= m[2, 2]:
-            qw = 1.0 + tr
-            qx = m[2, 1] - m[1, 2]
-            qy = m[0, 2] - m[2, 0]
-            qz = m[1, 0] - m[0, 1]
-        elif m[0, 0] >= m[1, 1] and m[0, 0] >= m[2, 2]:
-            qw = m[2, 1] - m[1, 2]
-            qx = 1.0 + m[0, 0] - m[1, 1] - m[2, 2]
-            qy = m[0, 1] + m[1, 0]
-            qz = m[0, 2] + m[2, 0]
-        elif m[1, 1] >= m[2, 2]:
-            qw = m[0, 2] - m[2, 0]
-            qx = m[0, 1] + m[1, 0]
-            qy = 1.0 - m[0, 0] + m[1, 1] - m[2, 2]
-            qz = m[1, 2] + m[2, 1]
-        else:
-            qw = m[1, 0] - m[0, 1]
-            qx = m[0, 2] + m[2, 0]
-            qy = m[1, 2] + m[2, 1]
-            qz = 1.0 - m[0, 0] - m[1, 1] + m[2, 2]
-        inv = 1.0 / (qx * qx + qy * qy + qz * qz + qw * qw) ** 0.5
-        qx *= inv
-        qy *= inv
-        qz *= inv
-        qw *= inv
-        tx = m[0, 3]
-        ty = m[1, 3]
-        tz = m[2, 3]
-        dq[j, 0] = qx
-        dq[j, 1] = qy
-        dq[j, 2] = qz
-        dq[j, 3] = qw
-        # dual part 0.5 * (t, 0) ⊗ q = 0.5 * (w t + t × r, -t · r)
-        dq[j, 4] = 0.5 * (qw * tx + ty * qz - tz * qy)
-        dq[j, 5] = 0.5 * (qw * ty + tz * qx - tx * qz)
-        dq[j, 6] = 0.5 * (qw * tz + tx * qy - ty * qx)
-        dq[j, 7] = -0.5 * (tx * qx + ty * qy + tz * qz)
-    return True
-
-
-def hemisphere_signs(dq, out):
-    """out[a, b] = -1 where joints a and b's rotation quaternions (dq[:, :4]) point into
-    opposite hemispheres, else 1: the DQS kernel's antipodality flips, once per frame.
-
-    dq : (J, 8) float32; out : (J, J) float32
-    """
-    np.matmul(dq[:, :4], dq[:, :4].T, out=out)
-    np.copysign(np.float32(1.0), out, out=out)
-    return out
-
-
 class Kernels:
-    """The compiled kernels (attributes ``lbs``, ``lbs_normals``, ``dqs``,
-    ``rigid_dual_quaternions``) and numba itself.
+    """The compiled kernels (attributes ``lbs``, ``lbs_normals``, ``dqs`` (positions, and
+    normals when given, see :mod:`.dqs_kernels`), ``rigid_dual_quaternions``) and numba
+    itself.
 
     Call them through :meth:`run`, which picks the number of threads and serialises calls:
     numba's default "workqueue" threading layer must not run two parallel kernels at once.
     """
 
     def __init__(self, numba):
-        global prange, _blend_apply4, _blend_apply4_normal, _dq_blend4_into, _dq_apply16
-        global _check_groups, _dq_blend_block, _scale_block, _dq_apply_one, _dqs_rigid_task
-        global _dqs_scaled_task
+        global prange, _blend_apply4, _blend_apply4_normal, _check_groups
         from . import skinning_simd
 
         assert DQS_TASK % skinning_simd.DQ_BLOCK == 0 and skinning_simd.DQ_BLOCK == 16
-        prange = numba.prange
+        prange = dqs_kernels.prange = numba.prange
         _check_groups = numba.njit(_check_groups_py)
-        helper = {"fastmath": FASTMATH, "inline": "always"}
-        _dq_blend_block = numba.njit(**helper)(_dq_blend_block_py)
-        _scale_block = numba.njit(**helper)(_scale_block_py)
-        _dq_apply_one = numba.njit(**helper)(_dq_apply_one_py)
-        _dqs_rigid_task = numba.njit(**helper)(_dqs_rigid_task_py)
-        _dqs_scaled_task = numba.njit(**helper)(_dqs_scaled_task_py)
         _blend_apply4 = skinning_simd.blend_apply4
         _blend_apply4_normal = skinning_simd.blend_apply4_normal
-        _dq_blend4_into = skinning_simd.dq_blend4_into
-        _dq_apply16 = skinning_simd.dq_apply16
+        dqs_kernels._dq_blend4_into = skinning_simd.dq_blend4_into
+        dqs_kernels._dq_apply16 = skinning_simd.dq_apply16
+        dqs_kernels._dq_apply16_normals = skinning_simd.dq_apply16_normals
+        # Inlined into the DQS kernel (numba IR), so constant flags fold away.
+        helper = {"fastmath": FASTMATH, "inline": "always"}
+        for name in ("_dqs_task", "_dq_blend_block", "_scale_block", "_dq_apply_one"):
+            setattr(dqs_kernels, name, numba.njit(**helper)(getattr(dqs_kernels, name + "_py")))
         self.max_threads = numba.config.NUMBA_NUM_THREADS
         self._call_lock = threading.Lock()
         f32 = numba.float32[:, ::1]
@@ -382,11 +168,12 @@ class Kernels:
         self.lbs = numba.njit([numba.void(f32, i32, f32, f32, f32)], **opts)(_lbs_py)
         self.lbs_normals = numba.njit([numba.void(f32, f32, i32, f32, f32, f32, f32)],
                                       **opts)(_lbs_normals_py)
-        self.dqs = numba.njit([numba.void(f32, i32, f32, f32, f32, f32, numba.boolean, f32)],
-                              **opts)(_dqs_py)
+        self.dqs = numba.njit(
+            [numba.void(f32, f32, i32, f32, f32, f32, f32, numba.boolean, f32, f32)],
+            **opts)(dqs_kernels._dqs_py)
         self.rigid_dual_quaternions = numba.njit(
             [numba.boolean(numba.float64[:, :, ::1], numba.float64, f32)],
-            cache=True, nogil=True)(_rigid_dual_quaternions_py)
+            cache=True, nogil=True)(dqs_kernels._rigid_dual_quaternions_py)
 
     def run(self, name, n_vertices, threads, *args):
         """Run kernel ``name`` on ``args`` with ``threads`` threads (None: one below

@@ -10,6 +10,10 @@ about 3 ns per vertex, about twice the memory-copy floor (measured by
 their 56 bytes each). LLVM lowers the 16-wide vectors to whatever the CPU has (AVX-512,
 two AVX halves, four SSE quarters).
 
+numba's on-disk cache of a kernel is keyed on a hash of the kernel's own source file, not of
+this one: after changing an intrinsic here, delete the kernels' entries in ``__pycache__``
+(``skinning_kernels.*.nb*``, ``dqs_kernels.*.nb*``), or the cached kernels keep the old code.
+
 The palette row of joint ``j`` is its skinning matrix ``K_j`` transposed and flattened:
 ``row[4 c + i] = K_j[i, c]`` (column ``c`` of the 4x4), so the blended matrix's columns are four
 4-float slices and ``K · (x, y, z, 1)`` is three vector multiply-adds.
@@ -18,10 +22,11 @@ from __future__ import annotations
 
 from llvmlite import ir
 from numba import types
+from numba.core import cgutils
 from numba.extending import intrinsic
 
-__all__ = ["blend_apply4", "blend_apply4_normal", "dq_blend4_into", "dq_apply16", "ROW",
-           "DQ_BLOCK"]
+__all__ = ["blend_apply4", "blend_apply4_normal", "dq_blend4_into", "dq_apply16",
+           "dq_apply16_normals", "ROW", "DQ_BLOCK"]
 
 ROW = 16  # floats per palette row
 _F32 = ir.FloatType()
@@ -165,6 +170,99 @@ def dq_blend4_into(typingctx, dq, signs, pivot, j0, j1, j2, j3, w0, w1, w2, w3, 
     return sig, codegen
 
 
+class _Vec:
+    """16-float vector arithmetic on an IR builder (fast-math flags as the blends use)."""
+
+    def __init__(self, builder):
+        self.b = builder
+
+    def mul(self, a, b):
+        return self.b.fmul(a, b, flags=_FAST)
+
+    def add(self, a, b):
+        return self.b.fadd(a, b, flags=_FAST)
+
+    def sub(self, a, b):
+        return self.b.fsub(a, b, flags=_FAST)
+
+    def div(self, a, b):
+        # An exact division (no reciprocal approximation), as numba's FASTMATH allows.
+        return self.b.fdiv(a, b, flags=("arcp", "contract", "reassoc", "nsz"))
+
+    def const(self, value):
+        return _splat(self.b, ir.Constant(_F32, value), ir.VectorType(_F32, DQ_BLOCK))
+
+    def cross_plus(self, r, w, p):
+        """r x p + w p, per component."""
+        (r0, r1, r2), (x, y, z) = r, p
+        return (self.add(self.sub(self.mul(r1, z), self.mul(r2, y)), self.mul(w, x)),
+                self.add(self.sub(self.mul(r2, x), self.mul(r0, z)), self.mul(w, y)),
+                self.add(self.sub(self.mul(r0, y), self.mul(r1, x)), self.mul(w, z)))
+
+    def rotate(self, r, w, two, p, t=(None, None, None)):
+        """p + two (r x (r x p + w p) + t): with two = 2 / |(r, w)|^2 the rotation of the
+        unnormalised quaternion (r, w) applied to p, plus 2 t / |(r, w)|^2."""
+        (r0, r1, r2), (cx, cy, cz) = r, self.cross_plus(r, w, p)
+        out = []
+        for k, rc in enumerate((self.sub(self.mul(r1, cz), self.mul(r2, cy)),
+                                self.sub(self.mul(r2, cx), self.mul(r0, cz)),
+                                self.sub(self.mul(r0, cy), self.mul(r1, cx)))):
+            if t[k] is not None:
+                rc = self.add(rc, t[k])
+            out.append(self.add(p[k], self.mul(two, rc)))
+        return out
+
+
+def _load_xyz(context, builder, array_type, array, row):
+    """x, y, z of 16 rows of an (N, 3) float32 array from ``row`` on, as three vectors."""
+    pts = builder.load(_rows(context, builder, array_type, array, row, 3, 3 * DQ_BLOCK),
+                       align=4)
+    return [builder.shuffle_vector(pts, pts, _mask(range(c, 3 * DQ_BLOCK, 3)))
+            for c in range(3)]
+
+
+def _store_xyz(context, builder, array_type, array, row, xyz):
+    """Interleave three 16-float vectors back into 16 rows of 3 from ``row`` on."""
+    n = DQ_BLOCK
+    xy = builder.shuffle_vector(xyz[0], xyz[1], _mask(range(2 * n)))
+    zz = builder.shuffle_vector(xyz[2], xyz[2], _mask(list(range(n)) * 2))
+    rows = builder.shuffle_vector(xy, zz, _mask([c * n + i for i in range(n) for c in range(3)]))
+    builder.store(rows, _rows(context, builder, array_type, array, row, 3, 3 * n), align=4)
+
+
+def _dq_apply(context, builder, signature, args, normals):
+    """Code of :func:`dq_apply16` (args blend, points, p0, out, v0) and, with ``normals``, of
+    :func:`dq_apply16_normals` (args blend, points, p0, rest normals, out, out normals, v0)."""
+    v = _Vec(builder)
+    rows = builder.load(_rows(context, builder, signature.args[0], args[0],
+                              ir.Constant(_I64, 0), 8, 8 * DQ_BLOCK), align=4)
+    # De-interleave: component c of the 16 blends.
+    b0, b1, b2, b3, e0, e1, e2, e3 = (
+        builder.shuffle_vector(rows, rows, _mask(range(c, 8 * DQ_BLOCK, 8))) for c in range(8))
+    r, w, d = (b0, b1, b2), b3, (e0, e1, e2)
+    two = v.div(v.const(2.0), v.add(v.add(v.mul(b0, b0), v.mul(b1, b1)),
+                                    v.add(v.mul(b2, b2), v.mul(b3, b3))))
+    # t = w d - e r + r x d (unnormalised: every term is quadratic in the blend)
+    t = [v.add(v.sub(v.mul(w, d[k]), v.mul(e3, r[k])), rd)
+         for k, rd in enumerate(v.cross_plus(r, v.const(0.0), d))]
+    points = _load_xyz(context, builder, signature.args[1], args[1], args[2])
+    out_index = 4 if normals else 3
+    _store_xyz(context, builder, signature.args[out_index], args[out_index], args[-1],
+               v.rotate(r, w, two, points, t))
+    if normals:
+        rest = _load_xyz(context, builder, signature.args[3], args[3], args[2])
+        nx, ny, nz = v.rotate(r, w, two, rest)
+        # Renormalised: exact for rotations already, needed after a blended scale.
+        length = v.add(v.add(v.mul(nx, nx), v.mul(ny, ny)), v.mul(nz, nz))
+        sqrt = cgutils.get_or_insert_function(
+            builder.module, ir.FunctionType(length.type, [length.type]),
+            f"llvm.sqrt.v{DQ_BLOCK}f32")
+        inv = v.div(v.const(1.0), builder.call(sqrt, [length]))
+        _store_xyz(context, builder, signature.args[5], args[5], args[-1],
+                   [v.mul(nx, inv), v.mul(ny, inv), v.mul(nz, inv)])
+    return context.get_dummy_value()
+
+
 @intrinsic
 def dq_apply16(typingctx, blend, points, p0, out, v0):
     """out[v0 : v0 + 16] = points[p0 : p0 + 16] moved by the blended dual quaternions
@@ -175,51 +273,18 @@ def dq_apply16(typingctx, blend, points, p0, out, v0):
     With the blend (r, w; d, e) normalised by |(r, w)|: p' = p + 2 r x (r x p + w p)
     + 2 (w d - e r + r x d). Every term is quadratic in the blend, so the normalisation is one
     factor 2 / |(r, w)|^2 (no square root). points and out (N, 3) float32."""
-    sig = types.none(blend, points, p0, out, v0)
-    n = DQ_BLOCK
-
     def codegen(context, builder, signature, args):
-        rows = builder.load(_rows(context, builder, signature.args[0], args[0],
-                                  ir.Constant(_I64, 0), 8, 8 * n), align=4)
-        # De-interleave: component c of the 16 blends, then x, y, z of the 16 points.
-        b0, b1, b2, b3, e0, e1, e2, e3 = (
-            builder.shuffle_vector(rows, rows, _mask(range(c, 8 * n, 8))) for c in range(8))
-        pts = builder.load(_rows(context, builder, signature.args[1], args[1], args[2], 3,
-                                 3 * n), align=4)
-        x, y, z = (builder.shuffle_vector(pts, pts, _mask(range(c, 3 * n, 3)))
-                   for c in range(3))
+        return _dq_apply(context, builder, signature, args, normals=False)
 
-        def mul(a, b):
-            return builder.fmul(a, b, flags=_FAST)
+    return types.none(blend, points, p0, out, v0), codegen
 
-        def add(a, b):
-            return builder.fadd(a, b, flags=_FAST)
 
-        def sub(a, b):
-            return builder.fsub(a, b, flags=_FAST)
+@intrinsic
+def dq_apply16_normals(typingctx, blend, points, p0, normals, out, out_normals, v0):
+    """:func:`dq_apply16` plus the normals: normals[p0 : p0 + 16] turned by the blend's
+    rotation and renormalised into out_normals[v0 : v0 + 16] (normals (N, 3) float32, read
+    from the same rows as the points)."""
+    def codegen(context, builder, signature, args):
+        return _dq_apply(context, builder, signature, args, normals=True)
 
-        vec = ir.VectorType(_F32, n)
-        norm = add(add(mul(b0, b0), mul(b1, b1)), add(mul(b2, b2), mul(b3, b3)))
-        # An exact division (no reciprocal approximation), as numba's FASTMATH allows.
-        two = builder.fdiv(_splat(builder, ir.Constant(_F32, 2.0), vec), norm,
-                           flags=("arcp", "contract", "reassoc", "nsz"))
-        # c = r x p + w p, t = w d - e r + r x d (unnormalised)
-        cx = add(sub(mul(b1, z), mul(b2, y)), mul(b3, x))
-        cy = add(sub(mul(b2, x), mul(b0, z)), mul(b3, y))
-        cz = add(sub(mul(b0, y), mul(b1, x)), mul(b3, z))
-        tx = add(sub(mul(b3, e0), mul(e3, b0)), sub(mul(b1, e2), mul(b2, e1)))
-        ty = add(sub(mul(b3, e1), mul(e3, b1)), sub(mul(b2, e0), mul(b0, e2)))
-        tz = add(sub(mul(b3, e2), mul(e3, b2)), sub(mul(b0, e1), mul(b1, e0)))
-        ox = add(x, mul(two, add(sub(mul(b1, cz), mul(b2, cy)), tx)))
-        oy = add(y, mul(two, add(sub(mul(b2, cx), mul(b0, cz)), ty)))
-        oz = add(z, mul(two, add(sub(mul(b0, cy), mul(b1, cx)), tz)))
-        # Interleave x, y, z back into 16 rows of 3.
-        xy = builder.shuffle_vector(ox, oy, _mask(range(2 * n)))
-        zz = builder.shuffle_vector(oz, oz, _mask(list(range(n)) * 2))
-        xyz = builder.shuffle_vector(xy, zz, _mask([c * n + i for i in range(n)
-                                                    for c in range(3)]))
-        builder.store(xyz, _rows(context, builder, signature.args[3], args[3], args[4], 3,
-                                 3 * n), align=4)
-        return context.get_dummy_value()
-
-    return sig, codegen
+    return types.none(blend, points, p0, normals, out, out_normals, v0), codegen
