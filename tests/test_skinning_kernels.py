@@ -196,3 +196,28 @@ def test_dqs_kernel_blocks_and_their_remainders_agree_with_numpy(v, scale):
         verts, normals = binding.skin_with_normals(pal, method="dqs", backend="numba")
         assert np.abs(verts - ref).max() <= 4e-6 * max(1.0, np.abs(ref).max())
         assert np.abs(normals - ref_normals).max() <= 4e-6
+
+
+def test_a_kernel_cache_is_flushed_when_the_vector_blocks_change(tmp_path):
+    """numba's cache of a kernel knows its own file only: the hash of skinning_simd.py kept
+    beside it decides whether the cached code is still the one those intrinsics give."""
+    class Cache:
+        cache_path = str(tmp_path)
+        flushes = 0
+
+        def flush(self):
+            self.flushes += 1
+
+    class Dispatcher:
+        _cache = Cache()
+        py_func = skinning_kernels._lbs_py
+
+    d = Dispatcher()
+    skinning_kernels._flush_if_simd_changed(d)   # no hash kept yet
+    assert d._cache.flushes == 1
+    skinning_kernels._flush_if_simd_changed(d)   # the same intrinsics: the cache stays
+    assert d._cache.flushes == 1
+    (stamp,) = tmp_path.iterdir()
+    stamp.write_text("the hash of other intrinsics")
+    skinning_kernels._flush_if_simd_changed(d)
+    assert d._cache.flushes == 2 and stamp.read_text() != "the hash of other intrinsics"

@@ -25,8 +25,10 @@ seconds, neither of which may show in the editor, so:
 """
 from __future__ import annotations
 
+import hashlib
 import os
 import threading
+from pathlib import Path
 
 import numpy as np
 
@@ -165,12 +167,12 @@ class Kernels:
         i32 = numba.int32[:, ::1]
         opts = {"parallel": True, "fastmath": FASTMATH, "cache": True, "nogil": True}
         self.numba = numba
-        self.lbs = numba.njit([numba.void(f32, i32, f32, f32, f32)], **opts)(_lbs_py)
-        self.lbs_normals = numba.njit([numba.void(f32, f32, i32, f32, f32, f32, f32)],
-                                      **opts)(_lbs_normals_py)
-        self.dqs = numba.njit(
-            [numba.void(f32, f32, i32, f32, f32, f32, f32, numba.boolean, f32, f32)],
-            **opts)(dqs_kernels._dqs_py)
+        self.lbs = _compiled(numba, _lbs_py, [numba.void(f32, i32, f32, f32, f32)], opts)
+        self.lbs_normals = _compiled(numba, _lbs_normals_py,
+                                     [numba.void(f32, f32, i32, f32, f32, f32, f32)], opts)
+        self.dqs = _compiled(
+            numba, dqs_kernels._dqs_py,
+            [numba.void(f32, f32, i32, f32, f32, f32, f32, numba.boolean, f32, f32)], opts)
         self.rigid_dual_quaternions = numba.njit(
             [numba.boolean(numba.float64[:, :, ::1], numba.float64, f32)],
             cache=True, nogil=True)(dqs_kernels._rigid_dual_quaternions_py)
@@ -183,6 +185,42 @@ class Kernels:
         with self._call_lock:
             self.numba.set_num_threads(max(1, min(int(threads), self.max_threads)))
             getattr(self, name)(*args)
+
+
+def _compiled(numba, func, signatures, opts):
+    """``func`` compiled for ``signatures`` only (a call with other types raises instead of
+    compiling), as ``numba.njit(signatures, **opts)`` does, but from numba's disk cache only
+    while the vector blocks it inlines are those the cache was built with."""
+    dispatcher = numba.njit(**opts)(func)
+    _flush_if_simd_changed(dispatcher)
+    for signature in signatures:
+        dispatcher.compile(signature)
+    dispatcher.disable_compile()
+    return dispatcher
+
+
+def _flush_if_simd_changed(dispatcher):
+    """numba keys a kernel's disk cache on a hash of the kernel's own source file, but the
+    kernels inline :mod:`.skinning_simd`'s intrinsics: keep that file's hash beside the cache
+    and empty the kernel's cache index when it differs, so the next compile rebuilds it
+    instead of loading code built from other intrinsics."""
+    cache = getattr(dispatcher, "_cache", None)
+    path = getattr(cache, "cache_path", None)
+    if path is None:  # caching off
+        return
+    from . import skinning_simd
+
+    digest = hashlib.sha256(Path(skinning_simd.__file__).read_bytes()).hexdigest()
+    func = dispatcher.py_func
+    stamp = Path(path) / f"{func.__module__}.{func.__name__}.simd-sha256"
+    try:
+        if stamp.is_file() and stamp.read_text() == digest:
+            return
+        cache.flush()
+        stamp.parent.mkdir(parents=True, exist_ok=True)
+        stamp.write_text(digest)
+    except OSError:  # a cache folder we cannot write: numba compiles without saving
+        pass
 
 
 _lock = threading.Lock()

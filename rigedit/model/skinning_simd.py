@@ -11,8 +11,8 @@ their 56 bytes each). LLVM lowers the 16-wide vectors to whatever the CPU has (A
 two AVX halves, four SSE quarters).
 
 numba's on-disk cache of a kernel is keyed on a hash of the kernel's own source file, not of
-this one: after changing an intrinsic here, delete the kernels' entries in ``__pycache__``
-(``skinning_kernels.*.nb*``, ``dqs_kernels.*.nb*``), or the cached kernels keep the old code.
+this one; :func:`rigedit.model.skinning_kernels._flush_if_simd_changed` keeps this file's hash
+beside the cache and rebuilds the kernels when it changes.
 
 The palette row of joint ``j`` is its skinning matrix ``K_j`` transposed and flattened:
 ``row[4 c + i] = K_j[i, c]`` (column ``c`` of the 4x4), so the blended matrix's columns are four
