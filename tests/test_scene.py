@@ -77,11 +77,8 @@ def test_a_posed_frame_with_skinned_normals_looks_like_one_with_recomputed_norma
     scene.view("front", angle=35)
     scene.update(walk_pose(quadruped))
     skinned = shot(plotter)
-    scene.skinning = "dqs"   # the filter path: normals recomputed from the points
+    scene.use_skinned_normals = False   # the filter path: normals recomputed from the points
     assert not scene.skinned_normals
-    assert scene.mesh_actor.GetMapper().GetInputAlgorithm() is scene._normals
-    scene.skinning = "lbs"
-    scene.use_skinned_normals = False
     scene._connect_normals()
     scene.update(walk_pose(quadruped))
     filtered = shot(plotter)
@@ -92,27 +89,26 @@ def test_a_posed_frame_with_skinned_normals_looks_like_one_with_recomputed_norma
     assert np.mean(diff > 0) > 0.001   # not the same picture: the two paths did differ
 
 
-def test_dqs_uses_the_filter_and_lbs_the_skinned_normals_again(plotter, quadruped):
-    scene = RigScene(plotter, quadruped, show_floor=False)
-    pose = walk_pose(quadruped)
-    scene.skinning = "dqs"
-    scene.update(pose)
-    shot(plotter)
-    shown = pv.wrap(scene.mesh_actor.GetMapper().GetInput())
-    np.testing.assert_allclose(shown.point_data["Normals"], recomputed_normals(scene.mesh),
-                               atol=1e-5)
-    scene.skinning = "lbs"
-    scene.update(pose)
-    plotter.render()
-    assert scene.mesh_actor.GetMapper().GetInputAlgorithm() is not scene._normals
-    palette = quadruped.skeleton.bind_matrices  # any palette: compare with the binding's own
+def test_dqs_and_lbs_both_show_normals_skinned_in_the_kernels_pass(plotter, quadruped):
     from rigedit.model.kinematics import skinning_matrices
 
-    expected = quadruped.binding.skin_with_normals(
-        skinning_matrices(quadruped.skeleton, quadruped.joint_matrices(pose)))[1].copy()
-    del palette
-    shown = pv.wrap(scene.mesh_actor.GetMapper().GetInput())
-    np.testing.assert_allclose(shown.point_data["Normals"], expected, atol=1e-6)
+    scene = RigScene(plotter, quadruped, show_floor=False)
+    pose = walk_pose(quadruped)
+    palette = skinning_matrices(quadruped.skeleton, quadruped.joint_matrices(pose))
+    shown_by = {}
+    for method in ("dqs", "lbs", "dqs"):
+        scene.skinning = method
+        scene.update(pose)
+        plotter.render()
+        assert scene.mesh_actor.GetMapper().GetInputAlgorithm() is not scene._normals
+        shown = np.array(pv.wrap(scene.mesh_actor.GetMapper().GetInput()).point_data["Normals"])
+        expected = quadruped.binding.skin_with_normals(palette, method=method)[1]
+        np.testing.assert_allclose(shown, expected, atol=1e-6)
+        cos = np.clip(np.sum(shown * recomputed_normals(scene.mesh), axis=1), -1, 1)
+        assert np.degrees(np.median(np.arccos(cos))) < 1.0   # the shading of the new points
+        shown_by[method] = shown
+    # the two methods turn the normals differently where joints bend
+    assert np.abs(shown_by["dqs"] - shown_by["lbs"]).max() > 1e-3
 
 
 def test_a_replaced_binding_gets_its_own_rest_normals(plotter, quadruped):

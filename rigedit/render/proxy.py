@@ -183,11 +183,7 @@ class ProxyActor:
 
     def skin(self, palette, method="lbs"):
         """Skin the proxy with ``palette`` (J, 4, 4) into its actor's points and normals."""
-        binding = self.proxy.binding
-        points, normals = binding.skin_with_normals(palette)
-        if method == "dqs":   # its normals blended linearly: only seen while moving
-            points = binding.skin(palette, method="dqs")  # leaves the normals' buffer alone
-        write_skin(self.mesh, points, normals)
+        write_skin(self.mesh, *self.proxy.binding.skin_with_normals(palette, method=method))
 
     def remove(self):
         self.plotter.remove_actor(self.actor, render=False)

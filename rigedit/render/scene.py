@@ -41,8 +41,8 @@ class RigScene:
     skinned_normals : bool
         Normals blended with the vertices in one pass (``SkinBinding.skin_with_normals``)
         instead of recomputed by ``vtkPolyDataNormals`` each frame: exact in the rest pose,
-        within shading noise when posed (README, Speed). Used while :attr:`skinning` is
-        "lbs"; with "dqs" the filter runs (the DQS kernel blends no normals).
+        within shading noise when posed (README, Speed), with either skinning method (the
+        DQS kernel turns each rest normal by the vertex's blended rotation).
     floor_style : {"plane", "lines"}
         The floor as a textured plane (the editor) or its grid lines alone (the recorder;
         see :func:`rigedit.render.floor.add_floor`).
@@ -119,7 +119,7 @@ class RigScene:
     @property
     def skinned_normals(self):
         """Whether the shown normals are skinned with the vertices (else VTK's filter)."""
-        return self.has_mesh and self.use_skinned_normals and self._skinning == "lbs"
+        return self.has_mesh and self.use_skinned_normals
 
     def _connect_normals(self):
         """Feed the mapper the mesh itself (its "Normals" array skinned by each update) or
@@ -287,7 +287,8 @@ class RigScene:
             palette = skinning_matrices(self.rig.skeleton, model)
             if self.skinned_normals:
                 self._bind_rest_normals()
-                write_skin(self.mesh, *self.rig.binding.skin_with_normals(palette))
+                write_skin(self.mesh, *self.rig.binding.skin_with_normals(
+                    palette, method=self.skinning))
             else:
                 write_skin(self.mesh, self.rig.binding.skin(palette, method=self.skinning))
         self.joint_positions[:] = model[:, :3, 3]
