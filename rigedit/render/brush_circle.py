@@ -7,7 +7,9 @@ brush's mouse handling is :mod:`rigedit.ui.weight_brush`'s. Never imports Qt.
 from __future__ import annotations
 
 import numpy as np
-import vtk
+from vtkmodules.vtkCommonCore import vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+from vtkmodules.vtkRenderingCore import vtkActor2D, vtkPolyDataMapper2D
 
 __all__ = ["BrushCircle", "CIRCLE_SEGMENTS", "CIRCLE_COLOR", "CIRCLE_OFF_MESH"]
 
@@ -21,25 +23,25 @@ class BrushCircle:
 
     Attributes
     ----------
-    polydata : vtk.vtkPolyData
+    polydata : vtkPolyData
         Its points (display x, y, 0) and one closed line.
-    actor : vtk.vtkActor2D
+    actor : vtkActor2D
         To add to a renderer (the overlay layer in the editor).
     """
 
     def __init__(self):
-        self.polydata = vtk.vtkPolyData()
-        pts = vtk.vtkPoints()
+        self.polydata = vtkPolyData()
+        pts = vtkPoints()
         pts.SetNumberOfPoints(CIRCLE_SEGMENTS)
         self.polydata.SetPoints(pts)
-        line = vtk.vtkCellArray()
+        line = vtkCellArray()
         line.InsertNextCell(CIRCLE_SEGMENTS + 1)
         for k in range(CIRCLE_SEGMENTS + 1):
             line.InsertCellPoint(k % CIRCLE_SEGMENTS)
         self.polydata.SetLines(line)
-        mapper = vtk.vtkPolyDataMapper2D()
+        mapper = vtkPolyDataMapper2D()
         mapper.SetInputData(self.polydata)
-        self.actor = vtk.vtkActor2D()
+        self.actor = vtkActor2D()
         self.actor.SetMapper(mapper)
         self.actor.GetProperty().SetLineWidth(2.0)
         self.actor.GetProperty().SetColor(*CIRCLE_COLOR)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 import pyvista as pv
-import vtk
+from vtkmodules.vtkRenderingCore import vtkActor
 from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLSphereMapper
 
 __all__ = ["JointGlyphs", "SPHERE_COLOR", "SELECTED_COLOR", "ACTIVE_COLOR",
@@ -77,7 +77,7 @@ class JointGlyphs:
         mapper.SetColorModeToDirectScalars()
         mapper.ScalarVisibilityOn()
         self.mapper = mapper
-        self.actor = vtk.vtkActor()
+        self.actor = vtkActor()
         self.actor.SetMapper(mapper)
         self.actor.PickableOff()  # picked by rigedit's own ray maths, not VTK pickers
         prop = self.actor.GetProperty()

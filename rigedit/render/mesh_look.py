@@ -8,7 +8,7 @@ mapper settings that colour the mesh by one joint's influence. Never imports Qt.
 from __future__ import annotations
 
 import pyvista as pv
-import vtk
+from vtkmodules.vtkCommonCore import vtkLookupTable
 
 from ..surface import display_texture
 
@@ -55,7 +55,7 @@ def set_display_mode(actor, mode):
 def weight_lut():
     """The heat map's lookup table over [0, 1]: blue (no influence) through green and
     yellow to red (full), as painters expect."""
-    lut = vtk.vtkLookupTable()
+    lut = vtkLookupTable()
     lut.SetHueRange(0.667, 0.0)
     lut.SetSaturationRange(0.85, 0.85)
     lut.SetValueRange(0.95, 0.95)

@@ -1,7 +1,7 @@
 """The overlay renderer: a second layer drawn over the mesh, for bones and gizmos."""
 from __future__ import annotations
 
-import vtk
+from vtkmodules.vtkRenderingCore import vtkRenderer
 
 __all__ = ["overlay_renderer"]
 
@@ -17,7 +17,7 @@ def overlay_renderer(plotter):
     if existing is not None:
         return existing
     ren_win = plotter.render_window
-    ren = vtk.vtkRenderer()
+    ren = vtkRenderer()
     ren.SetLayer(1)
     ren.InteractiveOff()
     ren.SetActiveCamera(plotter.renderer.GetActiveCamera())

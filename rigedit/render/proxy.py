@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pyvista as pv
-import vtk
+from vtkmodules.vtkFiltersCore import vtkDecimatePro
 from scipy.spatial import cKDTree
 
 from ..model.skinning import SkinBinding
@@ -77,7 +77,7 @@ def _decimate(vertices, faces, target_faces):
     of the input's."""
     mesh = pv.PolyData(np.asarray(vertices, float),
                        np.hstack([np.full((len(faces), 1), 3), faces]).ravel())
-    decimate = vtk.vtkDecimatePro()
+    decimate = vtkDecimatePro()
     decimate.SetInputData(mesh)
     decimate.SetTargetReduction(max(0.0, 1.0 - target_faces / max(len(faces), 1)))
     decimate.PreserveTopologyOn()

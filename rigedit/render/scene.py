@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pyvista as pv
-import vtk
+from vtkmodules.vtkFiltersCore import vtkPolyDataNormals
 
 from ..model.kinematics import skinning_matrices
 from . import mesh_look
@@ -75,7 +75,7 @@ class RigScene:
         if self.has_mesh:
             # Normals recomputed by VTK inside the pipeline each time the points change:
             # smooth shading stays right under deformation at a few ms per frame.
-            self._normals = vtk.vtkPolyDataNormals()
+            self._normals = vtkPolyDataNormals()
             self._normals.SetInputData(self.mesh)
             self._normals.SplittingOff()
             self._normals.ConsistencyOff()

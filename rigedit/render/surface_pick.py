@@ -9,7 +9,8 @@ Never imports Qt.
 from __future__ import annotations
 
 import numpy as np
-import vtk
+from vtkmodules.vtkCommonCore import reference
+from vtkmodules.vtkCommonDataModel import vtkStaticCellLocator
 
 from .ray import display_to_world, world_to_display
 
@@ -43,7 +44,7 @@ class SurfacePicker:
         if locator is None:
             return None
         ends = [display_to_world(renderer, x, y, z) for z in (0.0, 1.0)]
-        t, sub, cell = vtk.reference(0.0), vtk.reference(0), vtk.reference(0)
+        t, sub, cell = reference(0.0), reference(0), reference(0)
         hit, pcoords = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
         if not locator.IntersectWithLine(ends[0], ends[1], 0.0, t, hit, pcoords, sub, cell):
             return None
@@ -56,7 +57,7 @@ class SurfacePicker:
             return None
         stamp = (id(mesh), mesh.GetPoints().GetMTime())
         if self._locator_stamp != stamp:
-            self._locator = vtk.vtkStaticCellLocator()
+            self._locator = vtkStaticCellLocator()
             self._locator.SetDataSet(mesh)
             self._locator.BuildLocator()
             self._locator_stamp = stamp

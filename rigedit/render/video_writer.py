@@ -103,12 +103,12 @@ class FrameReader:
     """
 
     def __init__(self, plotter, buffers=4):
-        import vtk
+        from vtkmodules.vtkCommonCore import vtkUnsignedCharArray
 
         self.plotter = plotter
         self.ren_win = plotter.render_window
         self.width, self.height = (int(s) for s in self.ren_win.GetSize())
-        self._vtk = [vtk.vtkUnsignedCharArray() for _ in range(max(1, buffers))]
+        self._vtk = [vtkUnsignedCharArray() for _ in range(max(1, buffers))]
         for arr in self._vtk:
             arr.SetNumberOfComponents(3)
             arr.SetNumberOfTuples(self.width * self.height)
@@ -117,7 +117,7 @@ class FrameReader:
     def read(self):
         """The last rendered frame as read, for :meth:`image` (which may run in another
         thread); a view of a buffer that a later read reuses."""
-        from vtk.util.numpy_support import vtk_to_numpy
+        from vtkmodules.util.numpy_support import vtk_to_numpy
 
         arr = self._vtk[self._next]
         self._next = (self._next + 1) % len(self._vtk)
