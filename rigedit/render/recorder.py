@@ -82,7 +82,9 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
     quality : int
         imageio-ffmpeg quality 0-10 for MP4.
     preset : str
-        x264 preset; ``veryfast`` keeps the encoder from being the bottleneck.
+        x264 preset. The default ``veryfast`` (with a shorter lookahead and simpler
+        sub-pixel search, :class:`~rigedit.render.video_writer.VideoWriter`) keeps the
+        encoder's CPU small beside the render's; ``medium`` gives smaller files slower.
     skinning : {"lbs", "dqs"}
         Linear blend or dual-quaternion skinning.
     progress : callable(done, total) -> bool, optional
