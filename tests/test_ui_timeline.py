@@ -102,6 +102,19 @@ def test_joint_panel_refreshes_less_often_while_playing_and_shows_the_paused_pos
     assert shown[-1] == pytest.approx(0.25)
 
 
+def test_time_label_keeps_its_width_while_playing_and_fits_the_clips_end(window):
+    tl, label = window.timeline, window.timeline.time_label
+    widths = set()
+    for i in range(20):
+        tl.set_time(0.05 * i)
+        widths.add(label.width())
+    assert len(widths) == 1 and label.minimumWidth() == label.maximumWidth()
+    tl.clip_manager.set_duration(400.0)        # a long clip: more digits at its end
+    tl.set_time(400.0)
+    assert label.width() > widths.pop()
+    assert label.fontMetrics().horizontalAdvance(label.text()) <= label.width()
+
+
 def test_ruler_cursor_repaint_matches_a_whole_repaint(window, qtbot):
     ruler = window.timeline.ruler
     window.timeline.set_time(0.2)

@@ -28,6 +28,10 @@ from .timeline_ruler import TimelineRuler
 __all__ = ["TimelineDock", "TimelineRuler"]
 
 
+def _time_text(t, fps):
+    return f"{t:6.2f} s   frame {t * fps:5.1f}"
+
+
 def _button(text, tip, slot, checkable=False):
     b = QtWidgets.QToolButton()
     b.setText(text)
@@ -113,12 +117,10 @@ class TimelineDock(QtWidgets.QDockWidget):
         self.duration_spin.setToolTip("Clip duration")
         self.duration_spin.setKeyboardTracking(False)
         self.duration_spin.valueChanged.connect(self.clip_manager.set_duration)
-        self.time_label = QtWidgets.QLabel()
-        # A fixed size: a label that may change size re-lays out the whole dock on every
-        # playback frame's setText
-        self.time_label.setText("9999.99 s   frame 99999.9")
-        self.time_label.setFixedSize(max(150, self.time_label.sizeHint().width() + 8),
-                                     self.time_label.sizeHint().height())
+        self.time_label = QtWidgets.QLabel(_time_text(0.0, self.fps))
+        # A fixed size (fitted to the clip's last time by _show_time): a label that may
+        # change size re-lays out the whole dock on every playback frame's setText
+        self.time_label.setFixedHeight(self.time_label.sizeHint().height())
         for w in (self.stop_button, self.play_button, self.loop_box, QtWidgets.QLabel("Speed"),
                   self.speed_spin, self.fps_spin, QtWidgets.QLabel("  Clip"), self.clip_combo,
                   _button("New", "New empty clip", lambda: clips.new_clip()),
@@ -335,8 +337,16 @@ class TimelineDock(QtWidgets.QDockWidget):
         summary = clip.key_times() if clip is not None else []
         joint = clip.key_times(name) if clip is not None and name is not None else []
         self.ruler.set_data(self._duration(), self.fps, self.time, summary, joint, name)
-        t = self.time
-        self.time_label.setText(f"{t:6.2f} s   frame {t * self.fps:5.1f}")
+        self._show_time()
+
+    def _show_time(self):
+        label = self.time_label
+        # the clip's end has the most digits, and digits are of one width in UI fonts
+        width = max(130, label.fontMetrics().horizontalAdvance(
+            _time_text(self._duration(), self.fps)) + 8)
+        if label.width() != width or label.minimumWidth() != width:
+            label.setFixedWidth(width)
+        label.setText(_time_text(self.time, self.fps))
 
     # ================================================================== edits
     def _clip_changed(self, resample):
