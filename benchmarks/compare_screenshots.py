@@ -3,7 +3,7 @@
 
 Runs the editor of two versions of rigedit, each in its own process: ``--before COMMIT``
 (extracted with ``git archive`` into a temporary folder) and the working tree (or
-``--after COMMIT``). Each opens the bundled quadruped in a 1280x720 window, shows the walk
+``--after COMMIT``). Each opens the bundled quadruped in a 1500x900 window, shows the walk
 at ``--time`` seconds (a posed character, where skinned normals differ from recomputed ones),
 saves a screenshot of the window, then hides the mesh and saves a second one: the pixels
 that change are the mesh's. It prints, over the mesh's pixels (those of either version), over
@@ -43,7 +43,7 @@ def child(out, clip_time):
         warnings.simplefilter("ignore")
         rig = rigedit.load_rig()
     w = MainWindow(rig)
-    w.resize(1280, 720)
+    w.resize(1500, 900)   # above either version's minimum size, so both windows match
     w.show()
     for _ in range(20):
         app.processEvents()
@@ -125,7 +125,7 @@ def main():
     floor = in_view & ~mesh
     floor[: y + int(0.45 * h)] = False   # below the horizon of the default view
     print(f"before {args.before or 'working tree'}, after {args.after or 'working tree'}; "
-          f"walk at {args.time} s; 1280x720 window, 3D view {w}x{h}")
+          f"walk at {args.time} s; 1500x900 window, 3D view {w}x{h}")
     print(f"  mesh pixels   {stats(diff, mesh)}")
     print(f"  floor pixels  {stats(diff, floor)}")
     print(f"  whole window  {stats(diff, np.ones_like(mesh))}")
