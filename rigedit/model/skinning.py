@@ -293,10 +293,7 @@ class SkinBinding:
             if kernels is not None:
                 self._run_dqs(kernels, palette, self._rest_normals32, res, nrm)
             else:
-                dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
-                res[:], nrm[:] = dqs_skin(self.rest_vertices, self.indices, self.weights, dq,
-                                          scale if has_scale else None,
-                                          rest_normals=self._rest_normals32)
+                res[:], nrm[:] = self._dqs_numpy(palette, self._rest_normals32)
             return res, nrm
         if kernels is not None:
             self._palette16.reshape(-1, 4, 4)[:] = np.asarray(palette).transpose(0, 2, 1)
@@ -333,10 +330,15 @@ class SkinBinding:
         if kernels is not None and res.dtype == np.float32 and res.flags.c_contiguous:
             self._run_dqs(kernels, palette, self._no_normals, res, self._no_normals)
             return res
-        dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
-        res[:] = dqs_skin(self.rest_vertices, self.indices, self.weights, dq,
-                          scale if has_scale else None)
+        res[:] = self._dqs_numpy(palette)
         return res
+
+    def _dqs_numpy(self, palette, rest_normals=None):
+        """The numpy reference of DQS (:func:`~rigedit.model.dqs.dqs_skin`): (V, 3) float64
+        positions, and normals too when ``rest_normals`` (V, 3) is given."""
+        dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
+        return dqs_skin(self.rest_vertices, self.indices, self.weights, dq,
+                        scale if has_scale else None, rest_normals=rest_normals)
 
     def _run_dqs(self, kernels, palette, rest_normals, out, out_normals):
         """The compiled DQS kernel: positions into ``out``, normals too unless
