@@ -13,6 +13,7 @@ from scipy.spatial.transform import Rotation
 from builders import chain_skeleton
 from rigedit.model import Pose, Skeleton
 from rigedit.model.ik import drag_joint, fabrik, solve_chain, two_bone
+from rigedit.model.kinematics import local_to_model
 
 
 # ---------------------------------------------------------------------- the old solver
@@ -52,17 +53,13 @@ def _reference_rotation_between(a, b):
     return Rotation.from_rotvec(axis / s * np.arctan2(s, c))
 
 
-def _fk(sk, pose):
-    return sk.forward(pose.local_matrices())
-
-
 def reference_solve_chain(sk, pose, chain, end, target, tolerance=1e-13, max_iterations=200000):
     """The old ``solve_chain``, FABRIK run to ``tolerance`` (the editor's was 1e-6)."""
-    model = _fk(sk, pose)
+    model = local_to_model(sk, pose)
     points = np.vstack([model[chain, :3, 3], model[end, :3, 3]])
     solved = reference_fabrik(points, target, tolerance, max_iterations)
     for k, j in enumerate(chain):
-        model = _fk(sk, pose)
+        model = local_to_model(sk, pose)
         nxt = chain[k + 1] if k + 1 < len(chain) else end
         head = model[j, :3, 3]
         delta = _reference_rotation_between(model[nxt, :3, 3] - head, solved[k + 1] - head)
@@ -147,7 +144,7 @@ def test_drag_matches_the_old_solver_on_random_skeletons(chain_length, scale):
         sk = random_skeleton(rng, n, scale)
         pose = Pose(sk)
         pose.rotation[:] = Rotation.random(n, random_state=rng.integers(1 << 31)).as_quat()
-        model = _fk(sk, pose)
+        model = local_to_model(sk, pose)
         end = n - 1
         chain = list(range(end - chain_length, end))
         points = model[chain + [end], :3, 3]
@@ -162,7 +159,7 @@ def test_drag_matches_the_old_solver_on_random_skeletons(chain_length, scale):
         else:   # the same FABRIK as before, to the editor's tolerance
             reference_solve_chain(sk, ref, chain, end, target, 1e-6, 30)
         drag_joint(sk, pose, end, target, chain_length)
-        new, old = _fk(sk, pose), _fk(sk, ref)
+        new, old = local_to_model(sk, pose), local_to_model(sk, ref)
         np.testing.assert_allclose(new[:, :3, 3], old[:, :3, 3], atol=1e-6)
         np.testing.assert_allclose(new[:, :3, :3], old[:, :3, :3], atol=1e-6)
         if chain_length > 1:
@@ -179,13 +176,14 @@ def test_solve_chain_across_a_joint_outside_the_chain():
         sk = random_skeleton(rng, 6)
         pose = Pose(sk)
         chain, end = [1, 3], 5   # joints 2 and 4 turn with their parents
-        points = _fk(sk, pose)[chain + [end], :3, 3]
+        points = local_to_model(sk, pose)[chain + [end], :3, 3]
         target = _reachable_target(rng, points)
         ref = pose.copy()
         reference_solve_chain(sk, ref, chain, end, target)
-        solve_chain(sk, pose, chain, end, target, lambda p: _fk(sk, p))
-        np.testing.assert_allclose(_fk(sk, pose)[:, :3, 3], _fk(sk, ref)[:, :3, 3], atol=1e-6)
-        np.testing.assert_allclose(_fk(sk, pose)[end, :3, 3], target, atol=1e-6)
+        solve_chain(sk, pose, chain, end, target, lambda p: local_to_model(sk, p))
+        new, old = local_to_model(sk, pose), local_to_model(sk, ref)
+        np.testing.assert_allclose(new[:, :3, 3], old[:, :3, 3], atol=1e-6)
+        np.testing.assert_allclose(new[end, :3, 3], target, atol=1e-6)
 
 
 def test_drag_keeps_twist():
@@ -197,7 +195,7 @@ def test_drag_keeps_twist():
         pose = Pose(sk)
         before = pose.copy()
         end = 3
-        target = _reachable_target(rng, _fk(sk, pose)[1:, :3, 3])
+        target = _reachable_target(rng, local_to_model(sk, pose)[1:, :3, 3])
         drag_joint(sk, pose, end, target, 2)
         for j in (1, 2):
             r_old = Rotation.from_quat(before.rotation[j])
@@ -281,7 +279,7 @@ def test_drag_of_a_straight_chain_gives_finite_poses_keeping_lengths(target):
         drag_joint(sk, pose, 3, target, chain_length)
         assert np.isfinite(pose.rotation).all()
         np.testing.assert_allclose(np.linalg.norm(pose.rotation, axis=1), 1.0)
-        np.testing.assert_allclose(_lengths(_fk(sk, pose)[:, :3, 3]), 1.0, rtol=1e-9)
+        np.testing.assert_allclose(_lengths(local_to_model(sk, pose)[:, :3, 3]), 1.0, rtol=1e-9)
 
 
 def test_drag_with_a_zero_length_bone_gives_finite_poses():
@@ -291,6 +289,6 @@ def test_drag_with_a_zero_length_bone_gives_finite_poses():
         for chain_length in (1, 2):
             pose = Pose(sk)
             drag_joint(sk, pose, 3, target, chain_length)
-            new = _fk(sk, pose)[:, :3, 3]
+            new = local_to_model(sk, pose)[:, :3, 3]
             assert np.isfinite(new).all()
             np.testing.assert_allclose(_lengths(new), [1.0, 0.0, 1.0], atol=1e-12)
