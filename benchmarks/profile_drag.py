@@ -229,15 +229,10 @@ def pipeline_costs(w):
     out.append(("scene.update_from_matrices (skin + copy + bones)",
                 _median_ms(lambda: scene.update_from_matrices(model))))
     import pyvista as pv
-    from vtkmodules.vtkFiltersCore import vtkPolyDataNormals
 
-    normals = vtkPolyDataNormals()
-    normals.SetInputData(pv.PolyData(np.array(scene.mesh.points), scene.mesh.GetPolys()))
-    # as the scene configured it for the editor (rigedit/render/scene.py)
-    normals.SplittingOff()
-    normals.ConsistencyOff()
-    normals.AutoOrientNormalsOff()
-    normals.ComputeCellNormalsOff()
+    from rigedit.render.scene import normals_filter
+
+    normals = normals_filter(pv.PolyData(np.array(scene.mesh.points), scene.mesh.GetPolys()))
 
     def normals_update():
         normals.Modified()

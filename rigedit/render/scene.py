@@ -19,13 +19,25 @@ from .floor import add_floor
 from .proxy import ProxyActor, write_skin
 from .skeleton_actors import BareSkeleton, add_bones
 
-__all__ = ["RigScene", "faces_to_vtk"]
+__all__ = ["RigScene", "faces_to_vtk", "normals_filter"]
 
 
 def faces_to_vtk(faces):
     """(F, 3) triangles -> pyvista's flat ``[3, a, b, c, ...]`` cell array."""
     faces = np.asarray(faces, dtype=np.int64)
     return np.hstack([np.full((len(faces), 1), 3, dtype=np.int64), faces]).ravel()
+
+
+def normals_filter(polydata):
+    """``vtkPolyDataNormals`` on ``polydata`` as the scene runs it: smooth point normals
+    only (no split vertices, no cell normals), the triangles' winding taken as it is."""
+    normals = vtkPolyDataNormals()
+    normals.SetInputData(polydata)
+    normals.SplittingOff()
+    normals.ConsistencyOff()
+    normals.AutoOrientNormalsOff()
+    normals.ComputeCellNormalsOff()
+    return normals
 
 
 class RigScene:
@@ -59,9 +71,10 @@ class RigScene:
                  skinned_normals=True, floor_style="plane"):
         self.plotter = plotter
         self.rig = rig
-        self._skinning = skinning
-        #: Normals blended in the LBS pass from rest normals (VTK's, computed once) instead
-        #: of vtkPolyDataNormals on every changed frame, when the method is LBS
+        #: The skinning method of every update: "lbs" or "dqs" (``SkinBinding.skin``)
+        self.skinning = skinning
+        #: Normals blended in the skinning pass from rest normals (VTK's, computed once)
+        #: instead of vtkPolyDataNormals on every changed frame
         self.use_skinned_normals = bool(skinned_normals)
         self._normals_binding = None  # the binding whose rest normals were computed
         self.up = up_vector(rig.up)
@@ -73,14 +86,9 @@ class RigScene:
                                 faces_to_vtk(rig.faces) if len(rig.faces) else None)
         self.mesh_actor = None
         if self.has_mesh:
-            # Normals recomputed by VTK inside the pipeline each time the points change:
-            # smooth shading stays right under deformation at a few ms per frame.
-            self._normals = vtkPolyDataNormals()
-            self._normals.SetInputData(self.mesh)
-            self._normals.SplittingOff()
-            self._normals.ConsistencyOff()
-            self._normals.AutoOrientNormalsOff()
-            self._normals.ComputeCellNormalsOff()
+            # The filter gives the binding its rest normals (once, see _bind_rest_normals);
+            # it feeds the mapper only when the normals are not skinned (a few ms a frame)
+            self._normals = normals_filter(self.mesh)
             look = mesh_look.surface_look(rig, self.mesh)
             self.mesh_actor = plotter.add_mesh(self._normals, smooth_shading=True,
                                                specular=0.25, specular_power=20,
@@ -105,17 +113,6 @@ class RigScene:
         self.view("front")
 
     # ------------------------------------------------------------------ actors
-    @property
-    def skinning(self):
-        """The skinning method of every update: "lbs" or "dqs" (``SkinBinding.skin``);
-        setting it also picks where the normals come from."""
-        return self._skinning
-
-    @skinning.setter
-    def skinning(self, method):
-        self._skinning = method
-        self._connect_normals()
-
     @property
     def skinned_normals(self):
         """Whether the shown normals are skinned with the vertices (else VTK's filter)."""
@@ -282,7 +279,7 @@ class RigScene:
         if not self.has_mesh:
             self.bare_skeleton.update(model)
         elif skin and self.proxy_shown:
-            self.proxy_actor.skin(skinning_matrices(self.rig.skeleton, model), self._skinning)
+            self.proxy_actor.skin(skinning_matrices(self.rig.skeleton, model), self.skinning)
         elif skin:
             palette = skinning_matrices(self.rig.skeleton, model)
             if self.skinned_normals:
