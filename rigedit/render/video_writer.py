@@ -15,6 +15,9 @@ import queue
 import threading
 from pathlib import Path
 
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkCommonCore import vtkUnsignedCharArray
+
 from ..io.atomic import naming_target, temp_beside
 
 __all__ = ["VideoWriter", "ThreadedWriter", "FrameReader", "RecordingCancelled"]
@@ -107,8 +110,6 @@ class FrameReader:
     """
 
     def __init__(self, plotter, buffers=4):
-        from vtkmodules.vtkCommonCore import vtkUnsignedCharArray
-
         self.plotter = plotter
         self.ren_win = plotter.render_window
         self.width, self.height = (int(s) for s in self.ren_win.GetSize())
@@ -121,8 +122,6 @@ class FrameReader:
     def read(self):
         """The last rendered frame as read, for :meth:`image` (which may run in another
         thread); a view of a buffer that a later read reuses."""
-        from vtkmodules.util.numpy_support import vtk_to_numpy
-
         arr = self._vtk[self._next]
         self._next = (self._next + 1) % len(self._vtk)
         # the front buffer, which screenshot() reads
