@@ -73,9 +73,7 @@ class RigScene:
         self.rig = rig
         #: The skinning method of every update: "lbs" or "dqs" (``SkinBinding.skin``)
         self.skinning = skinning
-        #: Normals blended in the skinning pass from rest normals (VTK's, computed once)
-        #: instead of vtkPolyDataNormals on every changed frame
-        self.use_skinned_normals = bool(skinned_normals)
+        self._use_skinned_normals = bool(skinned_normals)  # see use_skinned_normals
         self._normals_binding = None  # the binding whose rest normals were computed
         self.up = up_vector(rig.up)
         self.front = front_vector(rig.up)
@@ -113,6 +111,18 @@ class RigScene:
         self.view("front")
 
     # ------------------------------------------------------------------ actors
+    @property
+    def use_skinned_normals(self):
+        """Normals blended in the skinning pass from rest normals (VTK's, computed once)
+        instead of ``vtkPolyDataNormals`` on every changed frame; setting it reconnects the
+        mesh's mapper to the chosen source at once."""
+        return self._use_skinned_normals
+
+    @use_skinned_normals.setter
+    def use_skinned_normals(self, on):
+        self._use_skinned_normals = bool(on)
+        self._connect_normals()
+
     @property
     def skinned_normals(self):
         """Whether the shown normals are skinned with the vertices (else VTK's filter)."""
