@@ -73,8 +73,11 @@ class TimelineRuler(QtWidgets.QWidget):
         super().resizeEvent(event)
 
     def changeEvent(self, event):
+        # the cached picture's colours come from the palette's current group, which
+        # follows the window's activation and the enabled state too
         if event.type() in (QtCore.QEvent.PaletteChange, QtCore.QEvent.FontChange,
-                            QtCore.QEvent.StyleChange):
+                            QtCore.QEvent.StyleChange, QtCore.QEvent.ActivationChange,
+                            QtCore.QEvent.EnabledChange):
             self._background = None
         super().changeEvent(event)
 
