@@ -16,9 +16,10 @@ weights, clips, total).
 positions, as a percentage of the bounding-box diagonal, ``rigedit.embedding.cd_j2j``) for
 the bundled characters' own meshes (truth: their shipped skeleton, every joint) and the
 Khronos CesiumMan and RiggedFigure (skinned at their rest pose; truth: the artist's joints
-that the name table below maps onto the humanoid template, only those counted). Each mesh is
-run twice: in its own frame with the orientation guessed, and turned (Z up, facing -X, times
-100, moved) with the orientation guessed again, so the guess is part of what is measured.
+that the name table of ``tests/test_embedding.py`` maps onto the humanoid template, only
+those counted). Each mesh is run twice: in its own frame with the orientation guessed, and
+turned (Z up, facing -X, times 100, moved) with the orientation guessed again, so the guess
+is part of what is measured.
 """
 from __future__ import annotations
 
@@ -35,29 +36,13 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
 
 import rigedit  # noqa: E402
 from rigedit.embedding import cd_j2j  # noqa: E402
 from rigedit.rigging.mesh_check import read_mesh  # noqa: E402
-
-DATA = ROOT.parent / "shared" / "data"
-
-#: Humanoid template joint -> the artist's joint (CesiumMan; RiggedFigure has the same names
-#: without the "Skeleton_" prefixes and with arm joints numbered from the shoulder).
-CESIUM = {"Hips": "Skeleton_torso_joint_1", "Spine": "Skeleton_torso_joint_2",
-          "Spine2": "torso_joint_3", "Neck": "Skeleton_neck_joint_1",
-          "Head": "Skeleton_neck_joint_2",
-          "LeftArm": "Skeleton_arm_joint_L__4_", "LeftForeArm": "Skeleton_arm_joint_L__3_",
-          "LeftHand": "Skeleton_arm_joint_L__2_", "RightArm": "Skeleton_arm_joint_R",
-          "RightForeArm": "Skeleton_arm_joint_R__2_", "RightHand": "Skeleton_arm_joint_R__3_",
-          "LeftUpLeg": "leg_joint_L_1", "LeftLeg": "leg_joint_L_2", "LeftFoot": "leg_joint_L_3",
-          "LeftToeBase": "leg_joint_L_5", "RightUpLeg": "leg_joint_R_1",
-          "RightLeg": "leg_joint_R_2", "RightFoot": "leg_joint_R_3",
-          "RightToeBase": "leg_joint_R_5"}
-RIGGED_FIGURE = {**{k: v.replace("Skeleton_", "") for k, v in CESIUM.items()},
-                 "LeftArm": "arm_joint_L_1", "LeftForeArm": "arm_joint_L_2",
-                 "LeftHand": "arm_joint_L_3", "RightArm": "arm_joint_R_1",
-                 "RightForeArm": "arm_joint_R_2", "RightHand": "arm_joint_R_3"}
+# the artists' joints that the humanoid template's joints map onto (the embedding tests')
+from test_embedding import DATA, KHRONOS  # noqa: E402
 
 # rigedit axis -> the turned input's: up is the input's +Z, forward its -X (left: -Y)
 TURN = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
@@ -118,7 +103,7 @@ def _truth_cases():
         sk = rig.skeleton
         out.append((f"bundled {name}", rig.vertices, rig.faces, name, list(sk.names),
                     sk.bind_matrices[:, :3, 3]))
-    for file, table in (("CesiumMan.glb", CESIUM), ("RiggedFigure.glb", RIGGED_FIGURE)):
+    for file, table in KHRONOS.items():
         path = DATA / "khronos-gltf" / file
         if not path.is_file():
             continue
