@@ -10,8 +10,9 @@ pv = pytest.importorskip("pyvista")
 from rigedit import Rig  # noqa: E402
 from rigedit.model.kinematics import skinning_matrices  # noqa: E402
 from rigedit.model.subdivide import subdivide_centroid  # noqa: E402
-from rigedit.render.proxy import build_proxy  # noqa: E402
+from rigedit.render.proxy import build_proxy, faces_to_vtk  # noqa: E402
 from rigedit.render.scene import RigScene  # noqa: E402
+from ui_window_fixture import editor_window  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -34,8 +35,7 @@ def test_subdivision_keeps_the_surface_and_interpolates_the_weights(quadruped, b
     corners = quadruped.vertices[quadruped.faces]
     np.testing.assert_allclose(big.vertices[n:], corners.mean(axis=1))
     # same area, same orientation (the signed volume of a closed mesh would change sign)
-    area = lambda r: pv.PolyData(r.vertices, np.hstack(  # noqa: E731
-        [np.full((len(r.faces), 1), 3), r.faces]).ravel()).area
+    area = lambda r: pv.PolyData(r.vertices, faces_to_vtk(r.faces)).area  # noqa: E731
     assert area(big) == pytest.approx(area(quadruped), rel=1e-9)
     # a centroid inside one bone's region moves exactly with its corners
     pose = walk_pose(quadruped)
@@ -99,12 +99,7 @@ def test_scene_draws_the_proxy_or_the_full_mesh_skinned_to_the_last_pose(big):
 
 
 def test_editor_shows_the_proxy_while_moving_and_says_so(qtbot, big):
-    from rigedit.ui import MainWindow
-
-    w = MainWindow(big)
-    qtbot.addWidget(w)
-    try:
-        w.show()
+    with editor_window(qtbot, big) as w:
         scene, label = w.scene, w.proxy_view.label
         # built in a worker thread: the full mesh is drawn meanwhile, and the label says so
         assert w.proxy_view.building and "preparing a proxy" in label.text()
@@ -124,21 +119,13 @@ def test_editor_shows_the_proxy_while_moving_and_says_so(qtbot, big):
         w.set_weights_view(True)    # the weight paint view colours the full mesh
         w.document.set_pose(w.document.pose)
         assert not scene.proxy_shown
-    finally:
-        w.close()
 
 
 def test_a_small_mesh_has_no_proxy(qtbot, quadruped):
-    from rigedit.ui import MainWindow
-
-    w = MainWindow(quadruped)
-    qtbot.addWidget(w)
-    try:
+    with editor_window(qtbot, quadruped) as w:
         assert w.scene.proxy is None and not w.proxy_view.label.isVisible()
         w.document.set_pose(walk_pose(quadruped))
         assert not w.scene.proxy_shown
-    finally:
-        w.close()
 
 
 def test_a_rebound_proxy_keeps_its_actor_and_skins_with_the_new_influences(big):

@@ -31,9 +31,11 @@ def small_humanoid_obj(tmp_path_factory):
     +X (so the orientation is not the identity), as an OBJ file."""
     import pyvista as pv
 
+    from rigedit.render.proxy import faces_to_vtk
+
     rig = rigedit.load_rig("humanoid")
-    faces = np.hstack([np.full((len(rig.faces), 1), 3), rig.faces]).ravel()
-    mesh = pv.PolyData(rig.vertices.copy(), faces).decimate(0.94).triangulate().clean()
+    mesh = pv.PolyData(rig.vertices.copy(), faces_to_vtk(rig.faces))
+    mesh = mesh.decimate(0.94).triangulate().clean()
     v = np.asarray(mesh.points, float)
     f = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:]
     v = v[:, [2, 1, 0]] * [1, 1, -1]  # +Z facing becomes +X facing (a turn about Y)

@@ -21,7 +21,8 @@ from scipy.spatial import cKDTree
 
 from ..model.skinning import SkinBinding
 
-__all__ = ["SkinProxy", "ProxyActor", "build_proxy", "write_skin", "PROXY_MIN_FACES", "PROXY_TARGET_FACES"]
+__all__ = ["SkinProxy", "ProxyActor", "build_proxy", "faces_to_vtk", "write_skin",
+           "PROXY_MIN_FACES", "PROXY_TARGET_FACES"]
 
 #: Meshes with more triangles than this get a proxy: the bundled characters (50-60k
 #: triangles) drag at 15-20 frames/s in full here, a mesh 3x their size would not.
@@ -64,6 +65,12 @@ class SkinProxy:
                          self.full_faces)
 
 
+def faces_to_vtk(faces):
+    """(F, 3) triangles -> pyvista's flat ``[3, a, b, c, ...]`` cell array."""
+    faces = np.asarray(faces, dtype=np.int64)
+    return np.hstack([np.full((len(faces), 1), 3, dtype=np.int64), faces]).ravel()
+
+
 def _copy_influences(binding, points, source):
     """A SkinBinding of ``points`` (P, 3) with the influences of ``binding``'s vertices
     ``source`` (P,)."""
@@ -75,8 +82,7 @@ def _decimate(vertices, faces, target_faces):
     """(vertices, faces) of the mesh decimated to about ``target_faces`` triangles, its
     topology kept (no holes opened, no edges made non-manifold); the vertices are a subset
     of the input's."""
-    mesh = pv.PolyData(np.asarray(vertices, float),
-                       np.hstack([np.full((len(faces), 1), 3), faces]).ravel())
+    mesh = pv.PolyData(np.asarray(vertices, float), faces_to_vtk(faces))
     decimate = vtkDecimatePro()
     decimate.SetInputData(mesh)
     decimate.SetTargetReduction(max(0.0, 1.0 - target_faces / max(len(faces), 1)))
@@ -156,8 +162,7 @@ class ProxyActor:
     def __init__(self, plotter, proxy, mesh_actor, rest_normals, texture=None, tcoords=None):
         self.plotter = plotter
         self.proxy = proxy
-        faces = np.hstack([np.full((len(proxy.faces), 1), 3), proxy.faces]).ravel()
-        mesh = pv.PolyData(proxy.vertices.astype(np.float32), faces)
+        mesh = pv.PolyData(proxy.vertices.astype(np.float32), faces_to_vtk(proxy.faces))
         rest_normals = _bind_normals(proxy, rest_normals)
         mesh.point_data.set_array(rest_normals.astype(np.float32), "Normals")
         mesh.point_data.active_normals_name = "Normals"

@@ -16,16 +16,10 @@ from ..model.kinematics import skinning_matrices
 from . import mesh_look
 from .camera import frame_view, front_vector, rest_points, up_vector
 from .floor import add_floor
-from .proxy import ProxyActor, write_skin
+from .proxy import ProxyActor, faces_to_vtk, write_skin
 from .skeleton_actors import BareSkeleton, add_bones
 
 __all__ = ["RigScene", "faces_to_vtk", "normals_filter"]
-
-
-def faces_to_vtk(faces):
-    """(F, 3) triangles -> pyvista's flat ``[3, a, b, c, ...]`` cell array."""
-    faces = np.asarray(faces, dtype=np.int64)
-    return np.hstack([np.full((len(faces), 1), 3, dtype=np.int64), faces]).ravel()
 
 
 def normals_filter(polydata):
