@@ -22,8 +22,8 @@ import numpy as np
 from .calibrate import foot_points, tail_point, unit
 from .name_map import _KNEE, bend_index
 
-__all__ = ["Leg", "find_legs", "LegCalibration", "leg_contacts", "ground", "motion_ground",
-           "LEG_GROUPS", "FOOT_TOL", "BRANCH_HEIGHT"]
+__all__ = ["Leg", "find_legs", "ancestors", "LegCalibration", "leg_contacts", "ground",
+           "motion_ground", "LEG_GROUPS", "FOOT_TOL", "BRANCH_HEIGHT"]
 
 FOOT_TOL = 0.1
 BRANCH_HEIGHT = 0.3
@@ -54,7 +54,8 @@ def tail_points(skeleton, mats):
     return out
 
 
-def _ancestors(skeleton, j):
+def ancestors(skeleton, j):
+    """Joint ``j`` and its ancestors up to the root, in that order."""
     out = []
     while j >= 0:
         out.append(int(j))
@@ -109,7 +110,7 @@ def find_legs(skeleton, mats):
                         [int(j) for j in skeleton.subtree(chain[k + 1])]))
     if not legs:
         return [], None, None
-    tops = [_ancestors(skeleton, skeleton.parents[leg.chain[0]]) for leg in legs]
+    tops = [ancestors(skeleton, skeleton.parents[leg.chain[0]]) for leg in legs]
     common = set(tops[0]).intersection(*tops[1:])
     hips = next(a for a in tops[0] if a in common)
     others = [t[0] for t in tops if t[0] != hips]
@@ -172,7 +173,7 @@ class LegCalibration:
         return foot_points(self.skeleton, self.feet, mats)
 
     def _forward(self):
-        p, sk = self.points, self.skeleton
+        p = self.points
         fore = [leg.contact for leg in self.legs if not self.hind(leg)]
         hind = [leg.contact for leg in self.legs if self.hind(leg)]
         fwd = np.zeros(3)
@@ -180,11 +181,8 @@ class LegCalibration:
             fwd = p[fore].mean(axis=0) - p[hind].mean(axis=0)
         fwd[1] = 0.0
         if np.linalg.norm(fwd) < 1e-6 * self.hip_height:
-            tails = tail_points(sk, self.mats)
             for leg in self.legs:  # heel to toe: ankle to the foot's far end
-                end = tails[leg.contact] if np.all(np.isfinite(tails[leg.contact])) \
-                    else p[leg.contact]
-                fwd += (end - p[leg.ankle]) * [1, 0, 1]
+                fwd += (self._end(leg) - p[leg.ankle]) * [1, 0, 1]
         if np.linalg.norm(fwd) < 1e-6 * self.hip_height:
             fwd = np.array([0.0, 0.0, 1.0])
         return unit(fwd)
@@ -197,10 +195,13 @@ class LegCalibration:
         """The leg's length standing straight, whatever the pose: its bones' lengths from the
         top joint down to the foot leaf, and the leaf's tail (a hoof) where it has one."""
         p = self.points
-        tail = tail_points(self.skeleton, self.mats)[leg.contact]
-        end = float(np.linalg.norm(tail - p[leg.contact])) if np.all(np.isfinite(tail)) \
-            else 0.0
+        end = float(np.linalg.norm(self._end(leg) - p[leg.contact]))
         return float(np.linalg.norm(np.diff(p[leg.chain], axis=0), axis=1).sum() + end)
+
+    def _end(self, leg):
+        """(3,) the foot leaf's tail in the pose, or the leaf itself when it has none."""
+        tail = tail_point(self.skeleton, self.mats[None], leg.contact)
+        return self.points[leg.contact] if tail is None else tail[0]
 
     def leg_counts(self):
         """(legs hanging from the hips, legs hanging from elsewhere)."""
@@ -214,12 +215,12 @@ class LegCalibration:
         sk = self.skeleton
         if any(j in leg.chain for leg in self.legs):
             return "legs"
-        up = _ancestors(sk, j)
+        up = ancestors(sk, j)
         if self.hips not in up:
             return None
         if self.chest is None:
             return "spine"
-        between = _ancestors(sk, self.chest)
+        between = ancestors(sk, self.chest)
         if j in between:
             return "spine"
         return "head" if self.chest in up else "tail"

@@ -7,6 +7,7 @@ from scipy.spatial.transform import Rotation
 
 from .calibrate import rotations_of, swing, unit
 from .chains import distribute_bend
+from .limbs import ancestors
 
 __all__ = ["transfer_rotations", "end_spec", "end_points"]
 
@@ -65,10 +66,7 @@ def transfer_rotations(src, tgt, inverse, smats, scal, rf, contact):
             for k, side in enumerate("LR") for part in ("foot", "toe")
             if f"{part}_{side}" in tgt.slots} if humanoid else {}
     pairs = []
-    above_hips, a = set(), tgt.hips
-    while a >= 0:
-        above_hips.add(a)
-        a = tsk.parents[a]
+    above_hips = set(ancestors(tsk, tgt.hips))
     for j in range(nj):
         p = tsk.parents[j]
         if j not in inverse:
