@@ -148,9 +148,8 @@ def test_frame_reader_reads_what_screenshot_reads(rig):
 
 def test_skinned_normals_match_the_filter_at_rest_and_stay_close_when_posed(rig):
     import pyvista as pv
-    import vtk
 
-    from rigedit.render.scene import RigScene
+    from rigedit.render.scene import RigScene, normals_filter
 
     plotter = pv.Plotter(off_screen=True, window_size=SIZE)
     try:
@@ -158,11 +157,8 @@ def test_skinned_normals_match_the_filter_at_rest_and_stay_close_when_posed(rig)
         assert scene.mesh_actor.GetMapper().GetInputAlgorithm() is not scene._normals
 
         def recomputed():
-            normals = vtk.vtkPolyDataNormals()
-            normals.SetInputData(pv.PolyData(scene.mesh.points.copy(), scene.mesh.GetPolys()))
-            normals.SplittingOff()
-            normals.ConsistencyOff()
-            normals.AutoOrientNormalsOff()
+            normals = normals_filter(pv.PolyData(scene.mesh.points.copy(),
+                                                 scene.mesh.GetPolys()))
             normals.Update()
             return pv.wrap(normals.GetOutput()).point_data["Normals"]
 

@@ -6,9 +6,8 @@ import numpy as np
 import pytest
 
 pv = pytest.importorskip("pyvista")
-vtk = pytest.importorskip("vtk")
 
-from rigedit.render.scene import RigScene  # noqa: E402
+from rigedit.render.scene import RigScene, normals_filter  # noqa: E402
 
 SIZE = (640, 400)
 BACKGROUND = "#2b2f36"  # the editor's
@@ -26,12 +25,7 @@ def plotter():
 
 def recomputed_normals(mesh):
     """What vtkPolyDataNormals gives for the mesh's current points (the editor's old path)."""
-    f = vtk.vtkPolyDataNormals()
-    f.SetInputData(pv.PolyData(np.array(mesh.points), mesh.GetPolys()))
-    f.SplittingOff()
-    f.ConsistencyOff()
-    f.AutoOrientNormalsOff()
-    f.ComputeCellNormalsOff()
+    f = normals_filter(pv.PolyData(np.array(mesh.points), mesh.GetPolys()))
     f.Update()
     return np.asarray(pv.wrap(f.GetOutput()).point_data["Normals"])
 
