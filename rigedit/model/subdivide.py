@@ -41,23 +41,23 @@ def subdivide_centroid(vertices, faces, indices, weights, num_joints, levels=1):
     """
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
-    idx = np.asarray(indices)
+    idx = np.array(indices, dtype=np.int32)
     w = np.asarray(weights, dtype=np.float64)
     k = idx.shape[1]
     for _ in range(levels):
         n, m = len(v), len(f)
         rows = np.repeat(np.arange(n), k)
-        dense = sp.csr_matrix((w.ravel(), (rows, idx.ravel())), shape=(n, num_joints))
+        per_joint = sp.csr_matrix((w.ravel(), (rows, idx.ravel())), shape=(n, num_joints))
         # each centroid's row: the mean of its three corners' rows
         corners = sp.csr_matrix((np.full(3 * m, 1.0 / 3.0), (np.repeat(np.arange(m), 3),
                                  f.ravel())), shape=(m, n))
-        mid_idx, mid_w = top_k_influences((corners @ dense).toarray(), k)
+        mid_idx, mid_w = top_k_influences((corners @ per_joint).toarray(), k)
         centroid = v[f].mean(axis=1)
         c = n + np.arange(m)
         a, b, d = f[:, 0], f[:, 1], f[:, 2]
         f = np.concatenate([np.column_stack([a, b, c]), np.column_stack([b, d, c]),
                             np.column_stack([d, a, c])])
         v = np.concatenate([v, centroid])
-        idx = np.concatenate([idx.astype(np.int32), mid_idx.astype(np.int32)])
+        idx = np.concatenate([idx, mid_idx])   # top_k_influences gives int32
         w = np.concatenate([w, mid_w])
-    return v, f, idx.astype(np.int32), w
+    return v, f, idx, w
