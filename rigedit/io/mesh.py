@@ -13,7 +13,8 @@ from .atomic import atomic_write
 from .jsonfile import MAX_MAGNITUDE
 from .paths import read_bytes, regular_file
 
-__all__ = ["MESH_SUFFIXES", "load_mesh", "save_obj", "weld_vertices", "triangulate"]
+__all__ = ["MESH_SUFFIXES", "load_mesh", "save_obj", "weld_vertices", "triangulate",
+           "third_party_read"]
 
 MESH_SUFFIXES = (".obj", ".ply", ".stl", ".vtk", ".vtu", ".vtp")
 
