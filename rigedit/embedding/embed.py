@@ -21,7 +21,7 @@ from .legs import LEG_TOP, leg_top_heights, lower_leg_tops, template_leg_top
 from .medial import medial_cells, pack_spheres
 from .place import place_carried, place_chains
 from .search import discrete_embedding
-from .template import reduce_template, surface_area
+from .template import reduce_template
 
 __all__ = ["Embedding", "EmbeddingError", "embed_skeleton"]
 
@@ -92,14 +92,14 @@ def _check_mesh(vertices, faces):
 
 
 def _frame(vertices, faces):
-    """Floor, height and middle plane (area-weighted centroid x) of the mesh."""
+    """Floor, height, middle plane (area-weighted centroid x) and surface area of the mesh."""
     tri = vertices[faces]
     area = face_areas(vertices, faces)
     centre = tri.mean(axis=1)
     plane = float(np.average(centre[:, 0], weights=area)) if area.sum() > 0 else float(
         vertices[:, 0].mean())
     return {"floor": float(vertices[:, 1].min()), "height": float(np.ptp(vertices[:, 1])),
-            "plane_x": plane}
+            "plane_x": plane, "area": float(area.sum())}
 
 
 def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None):
@@ -158,7 +158,7 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None)
         # Height says how big a standing character is but shrinks in a crouch; surface area
         # does not change with the pose but grows with girth: take the geometric mean.
         scale = np.sqrt(frame["height"] / max(reduced.height, 1e-12)
-                        * np.sqrt(surface_area(vertices, faces) / max(reduced.area, 1e-300)))
+                        * np.sqrt(frame["area"] / max(reduced.area, 1e-300)))
     else:
         scale = frame["height"] / max(np.max(kept[:, 1]) - reduced.floor, 1e-12) / 1.1
     if len(graph.points) < len(reduced.joints):
