@@ -22,7 +22,7 @@ import rigedit  # noqa: E402
 from rigedit.io.mesh import load_mesh, save_obj  # noqa: E402
 from rigedit.rig import Rig  # noqa: E402
 
-from ui_window_fixture import editor_window, menu_action  # noqa: E402
+from ui_window_fixture import answer_file_dialog, editor_window, menu_action  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -44,19 +44,6 @@ def small_humanoid_obj(tmp_path_factory):
     return path
 
 
-def _answer_open(monkeypatch, *answers):
-    asked = []
-    queue = list(answers)
-
-    def dialog(parent, caption, *args, **kwargs):
-        asked.append(caption)
-        assert queue, f"unexpected file dialog {caption!r}"
-        return str(queue.pop(0)), ""
-
-    monkeypatch.setattr(QtWidgets.QFileDialog, "getOpenFileName", staticmethod(dialog))
-    return asked
-
-
 def _open_dialog(w, qtbot):
     menu_action(w, "File", "Auto-rig mesh").trigger()
     dlg = w.autorig.dialog
@@ -65,7 +52,7 @@ def _open_dialog(w, qtbot):
 
 
 def _fill(dlg, monkeypatch, mesh, template="humanoid", up=None, forward=None):
-    asked = _answer_open(monkeypatch, mesh)
+    asked = answer_file_dialog(monkeypatch, "getOpenFileName", mesh)
     dlg.mesh_browse.click()
     assert asked == ["Mesh to auto-rig"]
     dlg.template_combo.setCurrentText(template)
@@ -96,12 +83,12 @@ def test_dialog_refuses_missing_mesh_and_parallel_axes(window, qtbot, monkeypatc
     assert dlg.arguments() == {"mesh": str(small_humanoid_obj), "template": "humanoid",
                                "up": "y", "forward": "x"}
     # a template file: chosen by its own dialog; none chosen falls back to the bundled one
-    _answer_open(monkeypatch, "")
+    answer_file_dialog(monkeypatch, "getOpenFileName", "")
     dlg.template_combo.setCurrentIndex(2)
     dlg.template_combo.activated.emit(2)
     assert dlg.template_combo.currentText() == "humanoid"
     skel = Path(rigedit.resolve_rig_path("quadruped")) / "skeleton.json"
-    _answer_open(monkeypatch, skel)
+    answer_file_dialog(monkeypatch, "getOpenFileName", skel)
     dlg.template_combo.setCurrentIndex(2)
     dlg.template_combo.activated.emit(2)
     assert dlg.arguments()["template"] == skel.parent   # a rig folder, by its skeleton.json

@@ -14,28 +14,12 @@ from rigedit.animation import Clip, Track  # noqa: E402
 from rigedit.io.rig_folder import load_rig_folder  # noqa: E402
 from rigedit.model.weights import compute_weights  # noqa: E402
 
-from ui_window_fixture import editor_window, menu_action  # noqa: E402
-
-
-def _answer(monkeypatch, name, *answers):
-    """Make the static QFileDialog.``name`` return ``answers`` in turn (then fail the test:
-    the action asked more often than expected); returns the list of the captions asked."""
-    asked = []
-    queue = list(answers)
-
-    def dialog(parent, caption, *args, **kwargs):
-        asked.append(caption)
-        assert queue, f"unexpected file dialog {caption!r}"
-        answer = queue.pop(0)
-        return answer if name == "getExistingDirectory" else (answer, "")
-
-    monkeypatch.setattr(QtWidgets.QFileDialog, name, staticmethod(dialog))
-    return asked
+from ui_window_fixture import answer_file_dialog, editor_window, menu_action  # noqa: E402
 
 
 def _no_dialogs(monkeypatch):
     for name in ("getExistingDirectory", "getOpenFileName", "getSaveFileName"):
-        _answer(monkeypatch, name)
+        answer_file_dialog(monkeypatch, name)
 
 
 def assert_same_rig(back, rig):
@@ -69,7 +53,7 @@ def test_save_as_then_save_from_the_menu(window, qtbot, tmp_path, monkeypatch):
     doc = window.document
     rig = doc.rig
     assert len(rig.clips) >= 3
-    asked = _answer(monkeypatch, "getExistingDirectory", str(tmp_path / "elk"))
+    asked = answer_file_dialog(monkeypatch, "getExistingDirectory", str(tmp_path / "elk"))
     (tmp_path / "elk").mkdir()
     menu_action(window, "File", "Save rig as").trigger()
     assert len(asked) == 1 and window.last_error is None
@@ -109,7 +93,7 @@ def test_open_edit_save_and_save_as_a_rig_folder(qtbot, tmp_path, monkeypatch):
     save_rig_folder(tmp_path / "a", _small_rig())
     with editor_window(qtbot, _small_rig()) as window:
         doc = window.document
-        _answer(monkeypatch, "getExistingDirectory", str(tmp_path / "a"))
+        answer_file_dialog(monkeypatch, "getExistingDirectory", str(tmp_path / "a"))
         menu_action(window, "File", "Open rig folder").trigger()
         qtbot.waitUntil(lambda: window.job is None, timeout=10000)
         assert window.last_error is None and doc.rig.path is not None
@@ -135,7 +119,7 @@ def test_open_edit_save_and_save_as_a_rig_folder(qtbot, tmp_path, monkeypatch):
         assert ("head", "rotation") in back.clips["bow"].tracks
         # Save As to a new folder: both load equal; later saves go to the new one
         (tmp_path / "b").mkdir()
-        _answer(monkeypatch, "getExistingDirectory", str(tmp_path / "b"))
+        answer_file_dialog(monkeypatch, "getExistingDirectory", str(tmp_path / "b"))
         menu_action(window, "File", "Save rig as").trigger()
         assert_same_rig(load_rig_folder(tmp_path / "b"), opened)
         _no_dialogs(monkeypatch)
@@ -153,7 +137,7 @@ def test_open_mesh_and_skeleton_from_the_menu(demo_window, qtbot, tmp_path, monk
     source = _small_rig()
     save_obj(tmp_path / "body.obj", source.vertices, source.faces)
     save_skeleton(tmp_path / "bones.json", source.skeleton, up=source.up)
-    asked = _answer(monkeypatch, "getOpenFileName", str(tmp_path / "body.obj"),
+    asked = answer_file_dialog(monkeypatch, "getOpenFileName", str(tmp_path / "body.obj"),
                     str(tmp_path / "bones.json"))
     old = window.document.rig
     window.document.set_joint_euler("neck", [10, 0, 0])
@@ -181,7 +165,8 @@ def test_open_mesh_and_skeleton_from_the_menu(demo_window, qtbot, tmp_path, monk
     assert window.info_panel.labels["Vertices"].text() == f"{len(rig.vertices):,}"
     # a broken skeleton file: one message naming it, the rig stays
     (tmp_path / "bad.json").write_text('{"joints": [{"name": "a", "head": "up"}]}')
-    _answer(monkeypatch, "getOpenFileName", str(tmp_path / "body.obj"), str(tmp_path / "bad.json"))
+    answer_file_dialog(monkeypatch, "getOpenFileName", str(tmp_path / "body.obj"),
+                       str(tmp_path / "bad.json"))
     menu_action(window, "File", "Open mesh + skeleton").trigger()
     qtbot.waitUntil(lambda: window.job is None, timeout=30000)
     assert window.document.rig is rig
@@ -230,7 +215,7 @@ def test_export_video_dialog_records_what_it_was_asked(window, qtbot, tmp_path, 
     doc = window.document
     assert doc.clips[doc.current_clip].duration >= 1.0
     out = tmp_path / "clip.gif"
-    _answer(monkeypatch, "getSaveFileName", str(out))
+    answer_file_dialog(monkeypatch, "getSaveFileName", str(out))
     path = _export_video(window, qtbot, {"width_spin": "160", "height_spin": "120",
                                          "fps_spin": "10", "start_spin": "0.2",
                                          "end_spin": "0.8"}, browse=True)

@@ -14,7 +14,7 @@ from PyQt5 import QtWidgets  # noqa: E402
 import rigedit  # noqa: E402
 from rigedit.rigging.calibrate import model_stack  # noqa: E402
 
-from ui_window_fixture import menu_action  # noqa: E402
+from ui_window_fixture import answer_file_dialog, menu_action  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 WALK = DATA / "bvh-bandai" / "dataset-1_walk_normal_002.bvh"
@@ -26,21 +26,10 @@ def _load(path):
         return rigedit.load_rig(path)
 
 
-def _choose(monkeypatch, path):
-    asked = []
-
-    def dialog(parent, caption, *args, **kwargs):
-        asked.append(caption)
-        return str(path), ""
-
-    monkeypatch.setattr(QtWidgets.QFileDialog, "getOpenFileName", staticmethod(dialog))
-    return asked
-
-
 def _import(w, qtbot, monkeypatch, path, add=True):
     """Import ``path`` through the menu; with ``add``, press Add clip in the joint map
     dialog (when the retarget gave a clip). Returns the dialog (None when none opened)."""
-    asked = _choose(monkeypatch, path)
+    asked = answer_file_dialog(monkeypatch, "getOpenFileName", path)
     menu_action(w, "File", "Import motion onto this character").trigger()
     # reading, then retargeting (a second job started when the first one ends)
     # (no event runs between the two: job is None only when both ended)

@@ -13,14 +13,12 @@ import pytest
 
 pytestmark = pytest.mark.ui
 
-from PyQt5 import QtWidgets  # noqa: E402
-
 import rigedit  # noqa: E402
 from rigedit.rigging import load_map, retarget_result  # noqa: E402
 from rigedit.rigging.calibrate import model_stack  # noqa: E402
 from rigedit.ui.joint_map_dialog import NONE  # noqa: E402
 
-from ui_window_fixture import menu_action  # noqa: E402
+from ui_window_fixture import answer_file_dialog, menu_action  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 WALK = DATA / "bvh-bandai" / "dataset-1_walk_normal_002.bvh"
@@ -34,20 +32,9 @@ def motion():
     pytest.skip(f"shared test data not found: {WALK}")
 
 
-def _patch_dialog(monkeypatch, name, answer):
-    asked = []
-
-    def dialog(parent, caption, *args, **kwargs):
-        asked.append(caption)
-        return str(answer), ""
-
-    monkeypatch.setattr(QtWidgets.QFileDialog, name, staticmethod(dialog))
-    return asked
-
-
 def _open_map(w, qtbot, monkeypatch, path):
     """Import ``path`` through the menu up to the joint map dialog (no clip added yet)."""
-    _patch_dialog(monkeypatch, "getOpenFileName", path)
+    answer_file_dialog(monkeypatch, "getOpenFileName", path)
     menu_action(w, "File", "Import motion onto this character").trigger()
     qtbot.waitUntil(lambda: w.job is None, timeout=120000)
     dialog = w.motion_import.dialog
@@ -84,7 +71,7 @@ def test_map_used_is_shown_and_saved_as_json_the_cli_reads(humanoid_window, qtbo
     assert dialog.add_button.isEnabled() and not dialog.retarget_button.isEnabled()
 
     out = tmp_path / "walk_map.json"
-    asked = _patch_dialog(monkeypatch, "getSaveFileName", out)
+    asked = answer_file_dialog(monkeypatch, "getSaveFileName", out)
     dialog.save_button.click()
     assert asked == ["Save joint map"]
     assert json.loads(out.read_text()) == expected
@@ -153,7 +140,7 @@ def test_loaded_map_is_used_and_bad_map_names_the_file(humanoid_window, qtbot, m
     assert len(legs) < len(auto)
     good = tmp_path / "legs_only.json"
     good.write_text(json.dumps({"map": legs}))
-    asked = _patch_dialog(monkeypatch, "getOpenFileName", good)
+    asked = answer_file_dialog(monkeypatch, "getOpenFileName", good)
     dialog.load_button.click()
     assert asked == ["Load joint map"]
     qtbot.waitUntil(lambda: w.job is None and dialog.add_button.isEnabled(), timeout=60000)
@@ -161,7 +148,7 @@ def test_loaded_map_is_used_and_bad_map_names_the_file(humanoid_window, qtbot, m
 
     bad = tmp_path / "typo_map.json"
     bad.write_text(json.dumps({**legs, "Hips": "Hipz"}))
-    _patch_dialog(monkeypatch, "getOpenFileName", bad)
+    answer_file_dialog(monkeypatch, "getOpenFileName", bad)
     clips_before = set(doc.clips)
     dialog.load_button.click()
     assert w.job is None

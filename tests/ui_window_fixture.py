@@ -85,6 +85,25 @@ def menu_action(window, menu, text):
     pytest.fail(f"expected an action {text!r} in the {menu} menu", pytrace=False)
 
 
+def answer_file_dialog(monkeypatch, name, *answers):
+    """Make the static ``QFileDialog.<name>`` ("getOpenFileName", "getSaveFileName",
+    "getExistingDirectory") return ``answers`` in turn, then fail the test (the action asked
+    more often than expected); returns the list of the captions asked."""
+    from PyQt5 import QtWidgets
+
+    asked = []
+    queue = list(answers)
+
+    def dialog(parent, caption, *args, **kwargs):
+        asked.append(caption)
+        assert queue, f"unexpected file dialog {caption!r}"
+        answer = str(queue.pop(0))
+        return answer if name == "getExistingDirectory" else (answer, "")
+
+    monkeypatch.setattr(QtWidgets.QFileDialog, name, staticmethod(dialog))
+    return asked
+
+
 def limb_joint(sk, name="fore_cannon_L"):
     """Joint ``name`` (by default the quadruped's left fore cannon, two below a non-branching
     chain: a lower leg), for drag tests; fails the test when the skeleton has no such joint."""
