@@ -29,6 +29,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ..errors import RigFileError
 from ..model import laplacian as lap
+from ..model.heat import WELD  # welded as the heat weights weld it
 
 __all__ = ["MeshCheck", "read_mesh", "check_mesh", "MAX_HOLE", "MAX_OPEN_AREA",
            "MAX_NONMANIFOLD", "MIN_MAIN_PART", "SMALL_PART"]
@@ -38,7 +39,6 @@ MAX_OPEN_AREA = 0.05
 MAX_NONMANIFOLD = 0.02
 MIN_MAIN_PART = 0.10
 SMALL_PART = 0.01
-WELD = 1e-6             # weld distance as a fraction of the bounding-box diagonal (as heat)
 
 
 @dataclass
