@@ -16,7 +16,7 @@ import numpy as np
 
 from .joint_glyphs import JointGlyphs
 from .observers import LeftButtonDrag, remove_observers
-from .ray import display_to_world, mouse_ray, pixel_spacing, sphere_entries, world_to_display
+from .ray import display_to_world, mouse_ray, pick_sphere, pixel_spacing, world_to_display
 
 __all__ = ["JointGizmos", "gizmo_radius"]
 
@@ -150,9 +150,7 @@ class JointGizmos(LeftButtonDrag):
         offset, growth = pixel_spacing(self.renderer, x, y)
         pixel = np.linalg.norm(offset[None, :] + along[:, None] * growth[None, :], axis=1)
         radius = np.maximum(self.radius, self.PICK_PIXELS * pixel)
-        t = sphere_entries(origin, direction, self.positions, radius)
-        j = int(np.argmin(t))
-        return (j, float(t[j])) if np.isfinite(t[j]) else (None, np.inf)
+        return pick_sphere(origin, direction, self.positions, radius)
 
     def pick(self, x, y):
         """The joint under display pixel (x, y), or None."""
