@@ -50,6 +50,9 @@ def test_closest_point_on_a_line_to_a_ray():
     s = closest_on_line(np.array([1.0, 2, 3]), np.array([1.0, 0, 0]),
                         np.array([4.0, 7, 10]), np.array([0.0, 0, -1]))
     assert s == pytest.approx(3.0)
+    ray = np.array([1.0, 1, 0]) / np.sqrt(2)  # oblique ray from the origin
+    s = closest_on_line(np.array([0.0, 5, 0]), np.array([1.0, 0, 0]), np.zeros(3), ray)
+    assert s == pytest.approx(5.0)
     assert closest_on_line(np.zeros(3), np.array([1.0, 0, 0]), np.ones(3),
                            np.array([-1.0, 0, 0])) is None
 

@@ -49,21 +49,6 @@ def _release(window):
     window.plotter.iren.interactor.InvokeEvent("LeftButtonReleaseEvent")
 
 
-def test_closest_point_on_axis_to_a_ray():
-    from rigedit.render.gizmos import AxisHandles
-
-    # the X axis through (1, 2, 3) and a ray along -Z through x = 4, y = 7
-    s = AxisHandles.closest_on_line(np.array([1.0, 2, 3]), np.array([1.0, 0, 0]),
-                                    np.array([4.0, 7, 10]), np.array([0.0, 0, -1]))
-    assert s == pytest.approx(3.0)
-    ray = np.array([1.0, 1, 0]) / np.sqrt(2)  # oblique ray from the origin
-    s = AxisHandles.closest_on_line(np.array([0.0, 5, 0]), np.array([1.0, 0, 0]),
-                                    np.zeros(3), ray)
-    assert s == pytest.approx(5.0)
-    assert AxisHandles.closest_on_line(np.zeros(3), np.array([1.0, 0, 0]), np.ones(3),
-                                       np.array([-1.0, 0, 0])) is None
-
-
 def test_x_arrow_drag_in_pose_mode_translates_root_along_x(window):
     doc = window.document
     rig, sk = doc.rig, doc.skeleton

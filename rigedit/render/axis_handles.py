@@ -170,8 +170,6 @@ class AxisHandles(LeftButtonDrag):
         """Whether the ray through (x, y) enters a visible joint sphere before ``depth``."""
         return self.gizmos is not None and self.gizmos.hit(x, y)[1] < depth
 
-    closest_on_line = staticmethod(closest_on_line)
-
     # ------------------------------------------------------------------ events
     @property
     def on_error(self):
