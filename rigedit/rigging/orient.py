@@ -161,15 +161,10 @@ def _nearest_axis(v):
 def _snap(up, forward):
     """The axis-aligned (up, forward) nearest to the given ones, when both are within
     ``SNAP_DEGREES``; None otherwise."""
-    out = []
-    for v in (up, forward):
-        k = int(np.argmax(np.abs(v)))
-        if np.degrees(np.arccos(min(1.0, abs(v[k])))) > SNAP_DEGREES:
-            return None
-        a = np.zeros(3)
-        a[k] = np.sign(v[k])
-        out.append(a)
-    return None if abs(out[0] @ out[1]) > 0 else tuple(out)
+    out = tuple(_nearest_axis(v) for v in (up, forward))
+    if any(a is None for a in out) or abs(out[0] @ out[1]) > 0:
+        return None
+    return out
 
 
 def _forward_cue(points, up, fwd, upright):
