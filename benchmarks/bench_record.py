@@ -62,7 +62,7 @@ def bare(rig, clip, frames, fps, size):
     from rigedit.model.kinematics import skinning_matrices
     from rigedit.model.skinning import vertex_normals
     from rigedit.render.mesh_look import MESH_COLOR
-    from rigedit.render.scene import faces_to_vtk
+    from rigedit.render.proxy import faces_to_vtk, write_skin
     from rigedit.render.video_writer import FrameReader
 
     binding = rig.binding
@@ -86,11 +86,7 @@ def bare(rig, clip, frames, fps, size):
             if clip is not None:
                 clip.sample(t, out=pose)
             palette = skinning_matrices(rig.skeleton, rig.joint_matrices(pose))
-            pts, nrm = binding.skin_with_normals(palette)
-            mesh.points[:] = pts
-            mesh.point_data["Normals"][:] = nrm
-            mesh.GetPoints().Modified()
-            mesh.Modified()
+            write_skin(mesh, *binding.skin_with_normals(palette))
             plotter.render()
             img = reader.read()
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0

@@ -290,13 +290,11 @@ def open_bare(app, rig, render_size, camera):
 
 
 def skin_into(rig, mesh, palette):
-    """Skin positions and normals in one pass and write them into ``mesh`` in place."""
-    pts, nrm = rig.binding.skin_with_normals(palette)
-    mesh.points[:] = pts
-    mesh.point_data["Normals"][:] = nrm
-    mesh.GetPointData().GetNormals().Modified()
-    mesh.GetPoints().Modified()
-    mesh.Modified()
+    """Skin positions and normals in one pass and write them into ``mesh`` in place (as
+    the scene does, :func:`rigedit.render.proxy.write_skin`)."""
+    from rigedit.render.proxy import write_skin
+
+    write_skin(mesh, *rig.binding.skin_with_normals(palette))
 
 
 def bare_frames(rig, plotter, mesh, palettes):
