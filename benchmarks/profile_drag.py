@@ -135,7 +135,7 @@ def profile_rows(profile, moves):
               "joint_matrices": "  FK (joint_matrices, all calls)",
               "update_from_matrices": "  scene update (skin + copy into VTK + bones)",
               "skin": "    skinning (LBS)",
-              "set_positions": "  move the 40 sphere widgets",
+              "set_positions": "  move the joint spheres (glyph points)",
               "show_joint": "  joint panel refresh"}
     rows = {}
     for (filename, _line, name), (_cc, _nc, _tt, ct, _callers) in st.stats.items():
