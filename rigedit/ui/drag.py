@@ -44,8 +44,8 @@ def constrain(start, center, axis):
 class DragController:
     """Turns gizmo drags into document edits.
 
-    In pose mode a drag poses the character (FABRIK over ``settings.chain_length`` joints,
-    or the root moved) from the pose at the press, and the release makes the whole drag one
+    In pose mode a drag poses the character (IK over ``settings.chain_length`` joints,
+    :func:`~rigedit.model.ik.drag_joint`, or the root moved) from the pose at the press, and the release makes the whole drag one
     undo step; in edit mode it moves the joint's bone preview and the release hands the new
     rest position to ``move_rest``.
 
