@@ -116,10 +116,10 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None)
     parent = template.parent
     children = [np.flatnonzero(parent == k) for k in range(r)]
     rest = template.rest[template.joints]
-    span = np.ptp(template.rest[~template.carried, 1])
+    # joints standing on the ground (ankles, hooves): their height is a strong cue
+    low = rest[:, 1] - template.floor < FEET * np.ptp(template.rest[~template.carried, 1])
     unary = np.stack([joint_costs(pts, rest[k, 1], template.floor, frame["floor"],
-                                  frame["height"], scale,
-                                  rest[k, 1] - template.floor < FEET * span) for k in range(r)])
+                                  frame["height"], scale, low[k]) for k in range(r)])
     # An optional branch goes only where the grid resolves the part (spheres of two cells
     # or more): on a part one cell thin (antlers, ears) the medial graph is too sparse to
     # place it, and carrying it from the template is better than a wrong embedding.
@@ -141,9 +141,7 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None)
     unit = 0.05 * template.size * scale
     sep = _separated_pairs(template)
     partner = {}
-    span = np.ptp(template.rest[~template.carried, 1])
-    foot = (rest[:, 1] - template.floor < FEET * span) & np.array(
-        [not np.any(parent == k) for k in range(r)])
+    foot = low & np.array([len(c) == 0 for c in children])
     gap_cache = {}
 
     def gap(q):
