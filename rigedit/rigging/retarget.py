@@ -196,7 +196,6 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
             rot, drop = hold_feet(tsk, tgt, rot, raw, contact, tgt.contacts, times, inverse)
         else:
             # fore and hind legs of other proportions than the source's: pitch the body
-            rot = rot.copy()
             pitched = raw if pitch_body(src, tgt, rot, raw, smats, s_legs) is None else \
                 assemble(tsk, rot, hips, hips_t)
             rot, drop = clean_legs(tsk, tgt, rot, pitched, contact, tgt.legs, times,
