@@ -34,8 +34,8 @@ def _foreign(rig):
 
 
 @pytest.fixture(scope="module")
-def human():
-    ref = rigedit.load_rig("humanoid")
+def human(humanoid):
+    ref = humanoid
     rig = rigedit.autorig((_foreign(ref), ref.faces), template="humanoid")
     return ref, rig
 
@@ -175,8 +175,8 @@ def _run(argv, capsys):
     return code, out, err
 
 
-def test_cli_errors_name_the_file(tmp_path, capsys):
-    ref = rigedit.load_rig("humanoid")
+def test_cli_errors_name_the_file(tmp_path, capsys, humanoid):
+    ref = humanoid
     # an open mesh: the body without its head and shoulders
     keep = ref.vertices[ref.faces].mean(axis=1)[:, 1] < 1.3
     open_mesh = tmp_path / "open.obj"
@@ -240,8 +240,8 @@ def test_cli_homer_prints_orientation_checks_and_times(tmp_path, capsys):
     assert head > 0.7 * np.ptp(rig.vertices[:, 1]) > foot
 
 
-def test_progress_reports_stages_in_order_and_a_raise_cancels():
-    ref = rigedit.load_rig("humanoid")
+def test_progress_reports_stages_in_order_and_a_raise_cancels(humanoid):
+    ref = humanoid
     seen = []
 
     class Cancelled(Exception):
@@ -260,13 +260,13 @@ def test_progress_reports_stages_in_order_and_a_raise_cancels():
     assert fractions == sorted(fractions) and 0.0 <= fractions[0] and fractions[-1] < 0.6
 
 
-def test_skeleton_file_template_without_clips(tmp_path):
+def test_skeleton_file_template_without_clips(tmp_path, humanoid):
     """A bare skeleton file: names and hierarchy come along, no clips (it has none)."""
     if not HOMER.is_file():
         pytest.skip(f"{HOMER} is absent (shared test data)")
     from rigedit.io.skeleton_json import save_skeleton
 
-    ref = rigedit.load_rig("humanoid")
+    ref = humanoid
     path = tmp_path / "skeleton.json"
     save_skeleton(path, ref.skeleton)
     rig = rigedit.autorig(HOMER, template=path, weights="idw")
