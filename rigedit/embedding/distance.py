@@ -55,10 +55,6 @@ class DistanceField:
         self.inside = inside
         self.nearest = nearest
 
-    @property
-    def shape(self):
-        return self.depth.shape
-
     def points(self, index):
         """Cell centres of integer indices ``index`` (N, 3) -> (N, 3) float64."""
         return self.origin + np.asarray(index, dtype=np.float64) * self.h
