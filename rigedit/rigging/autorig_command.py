@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import sys
-import warnings
 from pathlib import Path
 
 __all__ = ["run_autorig"]
@@ -13,7 +12,7 @@ def run_autorig(args):
 
     A progress bar shows on a terminal; Ctrl-C or SIGTERM stops the work between steps
     (see :mod:`rigedit.cli_output`)."""
-    from ..cli_output import check_interrupted
+    from ..cli_output import check_interrupted, warning_lines
     from .autorig import autorig
 
     bar = None
@@ -29,16 +28,13 @@ def run_autorig(args):
             bar.set_postfix_str(stage)
             bar.update(round(100 * fraction) - bar.n)
 
-    try:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
+    with warning_lines():  # heat's fallbacks, bones outside the mesh: a line each
+        try:
             rig = autorig(args.mesh, template=args.template, up=args.up, forward=args.forward,
                           weights=args.method, clips=not args.no_clips, progress=progress)
-    finally:
-        if bar is not None:
-            bar.close()
-    for w in caught:  # heat's fallbacks, bones outside the mesh: a line each
-        print(f"rigedit: warning: {w.message}", file=sys.stderr)
+        finally:   # closed before the warnings print
+            if bar is not None:
+                bar.close()
     for line in rig.autorig_report.lines():
         print(line)
     rig.save(args.output)
