@@ -74,8 +74,6 @@ def test_one_shot_playback_stops_at_the_end(window, qtbot):
 
 def test_joint_panel_refreshes_less_often_while_playing_and_shows_the_paused_pose(
         window, qtbot):
-    from rigedit.ui.main_window import PANEL_PLAYBACK_MS
-
     d, tl, panel = window.document, window.timeline, window.joint_panel
     d.select(d.skeleton.index["neck"])
     shown = []

@@ -24,7 +24,7 @@ import os
 import sys
 import traceback
 
-from PyQt5 import QtCore, QtWidgets
+from PyQt5 import QtWidgets
 
 from .. import recovery
 
