@@ -121,6 +121,16 @@ def test_editor_shows_the_proxy_while_moving_and_says_so(qtbot, big):
         assert not scene.proxy_shown
 
 
+def test_a_proxy_finished_after_the_window_closed_is_not_attached(qtbot, big):
+    with editor_window(qtbot, big) as w:
+        assert w.proxy_view.building
+        future = w.proxy_view._building[0]
+        w.close()
+        qtbot.waitUntil(future.done, timeout=60_000)
+        qtbot.wait(300)   # three polls of the finished build
+        assert w.scene.proxy is None and not w.proxy_view.building
+
+
 def test_a_small_mesh_has_no_proxy(qtbot, quadruped):
     with editor_window(qtbot, quadruped) as w:
         assert w.scene.proxy is None and not w.proxy_view.label.isVisible()

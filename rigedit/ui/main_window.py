@@ -576,6 +576,7 @@ class MainWindow(MenusMixin, JobsMixin, QtWidgets.QMainWindow):
             self.job.cancel()
             self.job.wait(5000)
         self.autosave.stop()
+        self.proxy_view.stop()  # a proxy finished after this is not attached to a closed view
         if not self.keep_recovery:
             self.autosave.discard(wait=True)  # a clean close leaves no recovery entry
         errors_hook.uninstall(self)
