@@ -98,11 +98,32 @@ def test_scene_draws_the_proxy_or_the_full_mesh_skinned_to_the_last_pose(big):
         plotter.close()
 
 
-def test_editor_shows_the_proxy_while_moving_and_says_so(qtbot, big):
+@pytest.fixture
+def held_build(monkeypatch):
+    """The windows' proxy builds wait in their worker until the test sets the returned
+    event (editor_window processes events before the test runs: a quick build would be
+    done by then)."""
+    import threading
+
+    from rigedit.ui import proxy_view
+
+    gate, real = threading.Event(), proxy_view.build_proxy
+
+    def build(*args, **kwargs):
+        gate.wait(60)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(proxy_view, "build_proxy", build)
+    yield gate
+    gate.set()
+
+
+def test_editor_shows_the_proxy_while_moving_and_says_so(qtbot, big, held_build):
     with editor_window(qtbot, big) as w:
         scene, label = w.scene, w.proxy_view.label
         # built in a worker thread: the full mesh is drawn meanwhile, and the label says so
         assert w.proxy_view.building and "preparing a proxy" in label.text()
+        held_build.set()
         qtbot.waitUntil(lambda: scene.proxy is not None, timeout=60_000)
         assert label.isVisible()
         assert label.text().strip() == f"Full mesh: {len(big.faces):,} triangles"
@@ -121,11 +142,12 @@ def test_editor_shows_the_proxy_while_moving_and_says_so(qtbot, big):
         assert not scene.proxy_shown
 
 
-def test_a_proxy_finished_after_the_window_closed_is_not_attached(qtbot, big):
+def test_a_proxy_finished_after_the_window_closed_is_not_attached(qtbot, big, held_build):
     with editor_window(qtbot, big) as w:
         assert w.proxy_view.building
         future = w.proxy_view._building[0]
         w.close()
+        held_build.set()
         qtbot.waitUntil(future.done, timeout=60_000)
         qtbot.wait(300)   # three polls of the finished build
         assert w.scene.proxy is None and not w.proxy_view.building
