@@ -99,6 +99,23 @@ def test_joint_panel_refreshes_less_often_while_playing_and_shows_the_paused_pos
     assert shown[-1] == pytest.approx(0.25)
 
 
+def test_a_panel_refresh_due_when_the_window_closes_does_not_run(window, qtbot):
+    from rigedit.ui.main_window import PANEL_PLAYBACK_MS
+
+    d, tl, panel = window.document, window.timeline, window.joint_panel
+    d.select(d.skeleton.index["neck"])
+    shown = []
+    panel.show_joint = lambda j, pose: shown.append(j)
+    tl.play()
+    tl.timer.stop()
+    tl.set_time(0.3)           # playing: the panel's refresh is due in PANEL_PLAYBACK_MS
+    assert window._panel_timer.isActive() and shown == []
+    tl.pause()
+    window.close()
+    qtbot.wait(2 * PANEL_PLAYBACK_MS)
+    assert shown == []
+
+
 def test_time_label_keeps_its_width_while_playing_and_fits_the_clips_end(window):
     tl, label = window.timeline, window.timeline.time_label
     widths = set()

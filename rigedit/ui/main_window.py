@@ -199,8 +199,7 @@ class MainWindow(MenusMixin, JobsMixin, QtWidgets.QMainWindow):
         self._panel_timer = QtCore.QTimer(self)
         self._panel_timer.setSingleShot(True)
         self._panel_timer.setInterval(PANEL_PLAYBACK_MS)
-        self._panel_timer.timeout.connect(
-            lambda: self.joint_panel.show_joint(self.document.selection, self.document.pose))
+        self._panel_timer.timeout.connect(self._refresh_joint_panel)
         p = self.joint_panel
         d = self.document
         p.joint_clicked.connect(d.select)
@@ -406,7 +405,11 @@ class MainWindow(MenusMixin, JobsMixin, QtWidgets.QMainWindow):
                 self._panel_timer.start()
             return
         self._panel_timer.stop()
-        self.joint_panel.show_joint(self.document.selection, self.document.pose)
+        self._refresh_joint_panel()
+
+    def _refresh_joint_panel(self):
+        if not self._closed:   # a refresh due after the window closed has nothing to show
+            self.joint_panel.show_joint(self.document.selection, self.document.pose)
 
     def _update_undo_actions(self):
         s = self.document.undo_stack
@@ -572,6 +575,7 @@ class MainWindow(MenusMixin, JobsMixin, QtWidgets.QMainWindow):
             event.ignore()  # the user chose Cancel, or the save did not happen
             return
         self._closed = True
+        self._panel_timer.stop()
         if self.job is not None:
             self.job.cancel()
             self.job.wait(5000)
