@@ -6,22 +6,47 @@ from scipy.spatial.transform import Rotation
 
 from ..animation.clip import Clip, Track
 
-__all__ = ["assemble", "to_clip"]
+__all__ = ["assemble", "to_clip", "model_scales"]
+
+
+def model_scales(skeleton):
+    """Each joint's scale in model space at rest: the column lengths of its rest model matrix.
+
+    A Mixamo glTF's hips (or its Armature node) scale by 0.01, so every bone below it is
+    in centimetres: a joint's own ``rest_scale`` is 1 there while its model scale is 0.01.
+
+    Returns
+    -------
+    scales : (J, 3) float64
+    """
+    rest = skeleton.forward(skeleton.rest_local_matrices())
+    return np.linalg.norm(rest[:, :3, :3], axis=-2)
 
 
 def assemble(skeleton, rot, hips, hips_pos):
     """Model matrices from model rotations, rest translations and the hips' model position.
 
+    Parameters
+    ----------
+    skeleton : Skeleton
+    rot : (F, J, 3, 3) float64
+        Model rotations (no scale).
+    hips : int
+    hips_pos : (F, 3) float64
+
     Returns
     -------
     mats : (F, J, 4, 4) float64
+        Each joint's rotation times its model scale at rest (:func:`model_scales`: the
+        scales inherited from its ancestors included).
     """
     n_frames, nj = rot.shape[:2]
     mats = np.zeros((n_frames, nj, 4, 4))
     mats[..., 3, 3] = 1.0
+    scales = model_scales(skeleton)
     for j in range(nj):
         p = skeleton.parents[j]
-        mats[:, j, :3, :3] = rot[:, j] * skeleton.rest_scale[j]
+        mats[:, j, :3, :3] = rot[:, j] * scales[j]
         if j == hips:
             mats[:, j, :3, 3] = hips_pos
         elif p >= 0:

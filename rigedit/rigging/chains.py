@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .bake import model_scales
 from .calibrate import rotations_of, swing
 
 __all__ = ["distribute_bend"]
@@ -42,6 +43,7 @@ def distribute_bend(skeleton, tgt, rot, mapped):
 def chain_vector(skeleton, rot, joints):
     """(F, 3) model vector from the parent of ``joints[0]`` to ``joints[-1]`` through each
     joint's rest offset, each turned by its parent's model rotation."""
+    scales = model_scales(skeleton)
     return sum(rot[:, skeleton.parents[j]] @ (skeleton.rest_translation[j]
-                                             * skeleton.rest_scale[skeleton.parents[j]])
+                                             * scales[skeleton.parents[j]])
                for j in joints)
