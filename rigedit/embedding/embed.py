@@ -16,6 +16,7 @@ from ..model.laplacian import face_areas
 from .distance import distance_field
 from .fit import W_SCALE_FIRM, W_SCALE_WEAK, fit_joints
 from .graph import medial_graph
+from .hints import HintError, check_hints
 from .inside import keep_inside
 from .legs import LEG_TOP, leg_top_heights, lower_leg_tops, template_leg_top
 from .medial import medial_cells, pack_spheres
@@ -23,7 +24,7 @@ from .place import place_carried, place_chains
 from .search import discrete_embedding
 from .template import reduce_template
 
-__all__ = ["Embedding", "EmbeddingError", "embed_skeleton"]
+__all__ = ["Embedding", "EmbeddingError", "HintError", "embed_skeleton"]
 
 
 #: An embedding costing more than this per reduced bone is refused: a fair fit costs well
@@ -102,7 +103,27 @@ def _frame(vertices, faces):
             "plane_x": plane, "area": float(area.sum())}
 
 
-def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None):
+def _pin(positions, pins):
+    """``positions`` (J, 3) with the pinned joints put at their points."""
+    out = np.array(positions, dtype=np.float64)
+    for j, point in pins.items():
+        out[j] = point
+    return out
+
+
+def _leg_pinned(reduced, pins):
+    """Whether a pinned joint is one :func:`lower_leg_tops` would move (hips, thighs, knees,
+    spine)."""
+    hips = {reduced.joints[reduced.parent[r]] for r in range(1, len(reduced.joints))
+            if len(reduced.chains[r]) > 2}
+    moved = set()
+    for r in range(1, len(reduced.joints)):
+        if reduced.joints[reduced.parent[r]] in hips:
+            moved.update(reduced.chains[r][:-1])
+    return bool(moved & set(pins))
+
+
+def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None, hints=None):
     """Embed a template skeleton in a closed (or nearly closed) triangle mesh.
 
     Parameters
@@ -118,6 +139,10 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None)
         The template's own mesh at its rest pose (a bundled character's, a .glb's). With it
         the scale comes from the two heights and the template's ground is known; without it
         both are estimated from the skeleton alone.
+    hints : dict[str, (3,) float], optional
+        Template joint name -> where it must be, in the frame of ``vertices``: those joints
+        are put exactly there and the search places the others around them
+        (:mod:`rigedit.embedding.hints`).
 
     Returns
     -------
@@ -128,6 +153,9 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None)
     EmbeddingError
         When the mesh is unusable or nothing in it fits the template; the message names the
         part of the template that found no place.
+    HintError
+        (a ValueError) naming the joint of a hint that is not the template's or lies
+        outside the mesh.
     """
     seconds = {}
     report = progress or (lambda fraction: None)
@@ -145,9 +173,11 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None)
         reduced = stage("template", 0.02, reduce_template, template, template_mesh)
     except ValueError as exc:
         raise EmbeddingError(str(exc)) from None
+    check_hints(hints, template.names)     # unknown names before the long stages
     field_ = stage("distance field", 0.3, distance_field, vertices, faces)
     if not field_.inside.any():
         raise EmbeddingError("the mesh encloses no volume (is it closed?)")
+    pins = check_hints(hints, template.names, field_)
     cells = stage("medial surface", 0.4, medial_cells, field_)
     spheres = stage("spheres", 0.45, pack_spheres, *cells, field_.h)
     graph = stage("graph", 0.55, medial_graph, field_, *spheres)
@@ -168,14 +198,19 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None)
             "(is it a blob without limbs?)")
     t0 = time.perf_counter()
     sub = (lambda f: report(0.55 + 0.25 * f)) if progress else None
-    found = discrete_embedding(graph, reduced, frame, scale, sub, field_)
+    found = discrete_embedding(graph, reduced, frame, scale, sub, field_, pins)
     seconds["search"] = time.perf_counter() - t0
     report(0.8)
     if found.vertex is None:
         raise EmbeddingError(f"no place found for the template's "
                              f"{reduced.label(template, found.failed)}")
-    if found.cost > MAX_COST_PER_BONE * max(len(reduced.joints) - 1, 1):
-        worst = int(np.argmax(found.parts))
+    # Chains through a hint are where the user said, however far from the template's pose
+    # (a deep crouch): their cost does not count against the fit (the others' does).
+    hinted = np.array([bool(set(reduced.chains[r] if r else [reduced.joints[0]]) & set(pins))
+                       for r in range(len(reduced.joints))])
+    if found.cost - found.parts[hinted].sum() > MAX_COST_PER_BONE * max(
+            len(reduced.joints) - 1, 1):
+        worst = int(np.argmax(np.where(hinted, -np.inf, found.parts)))
         raise EmbeddingError(
             f"no place found for the template's {reduced.label(template, worst)}: the best "
             f"embedding costs {found.cost:.0f}, a fitting one under "
@@ -186,18 +221,26 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None)
     positions[ok] = graph.points[found.vertex[ok]]
     paths = [None] + [graph.points[graph.path(found.vertex[reduced.parent[r]], found.vertex[r])]
                       if ok[r] else None for r in range(1, len(ok))]
+    for r, j in enumerate(reduced.joints):
+        if j in pins and ok[r]:
+            positions[r] = pins[j]
     hold = W_SCALE_FIRM if np.isfinite(reduced.height) else W_SCALE_WEAK
-    chains = place_chains(reduced, positions, paths)
+    chains = _pin(place_chains(reduced, positions, paths), pins)
     out, scale = stage("refinement", 0.95, fit_joints, field_, reduced, chains, scale,
-                       frame["floor"], hold, graph.points, frame["plane_x"])
-    # a deep trunk lifts the hips' sphere centre: the thighs go where the legs part
+                       frame["floor"], hold, graph.points, frame["plane_x"], pins)
+    # a deep trunk lifts the hips' sphere centre: the thighs go where the legs part (not
+    # when the user pinned a leg's joints: they said where the legs are)
     above = LEG_TOP if template_mesh is None else template_leg_top(reduced, *template_mesh)
-    out = lower_leg_tops(reduced, out, leg_top_heights(field_, reduced, out, frame["plane_x"],
-                                                       above))
-    out = stage("placement", 1.0, place_carried, reduced, out, scale, frame["floor"])
+    tops = leg_top_heights(field_, reduced, out, frame["plane_x"], above)
+    if not _leg_pinned(reduced, pins):
+        out = lower_leg_tops(reduced, out, tops)
+    # hinted carried joints first, so that the carried joints below them follow
+    out = stage("placement", 1.0, place_carried, reduced, _pin(out, pins), scale,
+                frame["floor"])
     placed_mask = np.zeros(len(out), dtype=bool)
     for r in np.flatnonzero(ok):
         placed_mask[reduced.chains[r][1:] if r else [reduced.joints[0]]] = True
+    placed_mask[list(pins)] = True
     t0 = time.perf_counter()
     out, cut, gone = keep_inside(field_, out, reduced.parents, placed_mask, vertices, faces,
                                reduced.mirror_all)

@@ -66,6 +66,9 @@ W_MIRROR_FIT = 0.5
 #: it came from the skeleton's height, good to 10-20%, so the bones may move it).
 W_SCALE_FIRM = 1.0
 W_SCALE_WEAK = 0.1
+#: Weight of a pinned joint (a user's hint) at its point: far above every other term, so the
+#: others arrange themselves around it.
+W_PIN = 1000.0
 
 
 def _chain_of(template, n):
@@ -77,7 +80,7 @@ def _chain_of(template, n):
 
 
 def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK,
-               medial=None, plane=None):
+               medial=None, plane=None, pins=None):
     """Solve the embedded chain joints for shape and middle together.
 
     Parameters
@@ -96,6 +99,9 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
         Points inside the mesh (the medial spheres' centres) to pull back joints that left it.
     hold_scale : float
         How firmly the scale stays (``W_SCALE_FIRM`` when it came from the template's mesh).
+    pins : dict[int, (3,) float64], optional
+        Template joint -> a point it must be at (the user's hints): held there with
+        ``W_PIN`` and put exactly there at the end.
 
     Returns
     -------
@@ -132,6 +138,8 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
     scale0 = scale
     medial_tree = cKDTree(medial) if medial is not None and len(medial) else None
     medial = medial if medial_tree is not None else None
+    pinned = np.array([slot[j] for j in (pins or {}) if slot[j] >= 0], dtype=np.int64)
+    pin_at = np.array([pins[j] for j in (pins or {}) if slot[j] >= 0]).reshape(-1, 3)
     for _ in range(ROUNDS):
         # each bone turns towards its present direction by how thin its part is: limbs
         # follow the mesh, the trunk keeps the template's directions (frames are shared)
@@ -156,6 +164,7 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
             if out_.any():
                 target[out_] = medial[medial_tree.query(x[out_])[1]]
                 lam[out_] = W_INSIDE
+        target[pinned], lam[pinned] = pin_at, W_PIN
         try:
             x_new, s_new = _solve(k, pb, cb, v, lam, target, scale0, rows, hold_scale)
         except np.linalg.LinAlgError:
@@ -165,6 +174,7 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
         x, scale = x_new, s_new
     if medial is not None:
         x = _step_inside(field, x, medial[medial_tree.query(x)[1]])
+    x[pinned] = pin_at
     out = positions.copy()
     out[idx] = x
     return out, scale

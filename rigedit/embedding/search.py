@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .fit import FEET
+from .hints import hint_pair, hint_unary
 from .penalties import SEPARATE_RATIO, W_CARRY, bone_costs, joint_costs, mirror_cost
 
 __all__ = ["Search", "discrete_embedding"]
@@ -89,7 +90,7 @@ def _separated_pairs(template):
     return pairs
 
 
-def discrete_embedding(graph, template, frame, scale, progress=None, field=None):
+def discrete_embedding(graph, template, frame, scale, progress=None, field=None, hints=None):
     """Embed ``template`` (a ReducedTemplate) into ``graph`` (a MedialGraph).
 
     Parameters
@@ -104,6 +105,10 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None)
     field : DistanceField, optional
         The mesh's distance field: two feet must then stand apart, the straight segment
         between them leaving the mesh (a gap between the legs), which no blob has.
+    hints : dict[int, (3,) float64], optional
+        Template joint -> where the user pinned it (:mod:`rigedit.embedding.hints`): a hinted
+        reduced joint goes near its hint, a chain with a hinted inner joint is scored through
+        it.
 
     Returns
     -------
@@ -128,6 +133,17 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None)
         unary[k, thin] = np.inf
     pair = [None] + [bone_costs(pts, dist, rest[k] - rest[parent[k]], template.chain_length[k],
                                 scale) for k in range(1, r)]
+    unit = 0.05 * template.size * scale
+    for j, point in (hints or {}).items():
+        if j in template.joints:
+            unary[int(np.flatnonzero(template.joints == j)[0])] += hint_unary(pts, point, unit)
+            continue
+        for k in range(1, r):
+            chain = template.chains[k]
+            if j in chain[1:-1]:
+                pair[k] = pair[k] + hint_pair(pts, point, template.rest[chain[0]],
+                                              template.rest[j], template.rest[chain[-1]],
+                                              scale)
     # down[k][v]: exact least tree cost of k's subtree with k at v.
     # best[k][a]: least cost of k's subtree given its parent at a (carrying included).
     down = [None] * r
@@ -138,7 +154,6 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None)
             best[k] = np.min(pair[k] + down[k][None, :], axis=1)
             if template.optional[k]:
                 best[k] = np.minimum(best[k], W_CARRY)
-    unit = 0.05 * template.size * scale
     sep = _separated_pairs(template)
     partner = {}
     foot = low & np.array([len(c) == 0 for c in children])
