@@ -238,6 +238,9 @@ def build_parser():
     s.add_argument("--save-map", default=None, metavar="MAP.json", help="write the map used")
     s.add_argument("--clip", default=None, metavar="NAME", help="the motion's clip to use")
     s.add_argument("--name", default=None, metavar="NEW", help="the new clip's name")
+    s.add_argument("--strict", action="store_true",
+                   help="fail (exit 2, nothing written) when the map leaves an arm, a leg, "
+                        "the spine or the head unmapped")
     s.add_argument("-o", "--output", required=True, metavar="FOLDER|OUT.glb|CLIP.json")
     _scale_option(s)
     s.set_defaults(func=cmd_retarget)

@@ -6,12 +6,13 @@ import numpy as np
 from .name_map import find_slots
 
 __all__ = ["Calibration", "calibrate", "model_stack", "swing", "unit", "rotations_of",
-           "foot_points", "tail_point", "HUMANOID_GROUPS"]
+           "foot_points", "tail_point", "ancestors", "HUMANOID_GROUPS"]
 
 #: Groups of bones reported by :func:`rigedit.rigging.measure.direction_errors` for humanoids:
 #: "feet" (foot and toe bones) apart, as their pitch is transferred relative to each figure's
-#: flat foot, not copied (see :mod:`.retarget`), so they differ by design.
-HUMANOID_GROUPS = ("arms", "legs", "spine", "head", "feet")
+#: flat foot, not copied (see :mod:`.retarget`), so they differ by design; "fingers": the
+#: joints below the hands, mapped when both skeletons name them.
+HUMANOID_GROUPS = ("arms", "legs", "spine", "head", "feet", "fingers")
 
 
 def unit(v, eps=1e-12):
@@ -148,8 +149,10 @@ class Calibration:
         """The measure group of joint ``j`` (one of :data:`HUMANOID_GROUPS`), or None."""
         slot = {v: k for k, v in self.slots.items()}.get(j)
         if slot is None:
+            hands = {self.slots[f"hand_{k}"] for k in "LR"}
             return "spine" if j in self.chains["spine"] else \
-                "head" if j in self.chains["neck"] else None
+                "head" if j in self.chains["neck"] else \
+                "fingers" if hands & set(ancestors(self.skeleton, j)) else None
         if slot.startswith(("clavicle", "upper_arm", "forearm", "hand")):
             return "arms"
         if slot.startswith(("thigh", "shin")):
@@ -157,6 +160,15 @@ class Calibration:
         if slot.startswith(("foot", "toe")):
             return "feet"
         return "head" if slot in ("neck", "head") else "spine"
+
+
+def ancestors(skeleton, j):
+    """Joint ``j`` and its ancestors up to the root, in that order."""
+    out = []
+    while j >= 0:
+        out.append(int(j))
+        j = skeleton.parents[j]
+    return out
 
 
 def tail_point(skeleton, mats, j):

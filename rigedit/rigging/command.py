@@ -25,8 +25,10 @@ def _pick_clip(rig, name, path):
 def run_retarget(args, load):
     """Retarget ``args.motion``'s clip onto ``args.to`` and write ``args.output``.
 
-    ``load(path, scale=...)`` reads a rig (the CLI's loader, which prints warnings)."""
-    from .name_map import load_map, save_map
+    ``load(path, scale=...)`` reads a rig (the CLI's loader, which prints warnings). A map
+    that leaves an arm, a leg, the spine or the head of the target unmapped is a warning
+    listing them; with ``args.strict`` an error (nothing is written)."""
+    from .name_map import load_map, save_map, unmapped_parts
     from .retarget import retarget_result
 
     source = load(args.motion, scale=args.scale)
@@ -41,6 +43,14 @@ def run_retarget(args, load):
     print(f"map ({len(res.mapping)} joints, source -> target):")
     for s, t in res.mapping.items():
         print(f"  {s} -> {t}")
+    tsk = target.skeleton
+    missing = unmapped_parts(res.target_calibration, [tsk.index[t] for t in res.mapping.values()])
+    if missing:
+        what = (f"the joint map from {args.motion} leaves parts of the target unmapped (they "
+                f"keep their rest pose): {'; '.join(missing)}")
+        if args.strict:
+            raise RigFileError(args.to, f"{what}; give a joint map (--map) or drop --strict")
+        print(f"rigedit: warning: {args.to}: {what}", file=sys.stderr)
     print(f"calibration: source {res.source_calibration.source}, target "
           f"{res.target_calibration.source}; facing turn {res.facing_degrees:g} deg; "
           f"scale {res.scale:.3f}; contact frames {res.contact.any(axis=1).sum()} of "

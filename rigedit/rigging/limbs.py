@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .calibrate import foot_points, tail_point, unit
+from .calibrate import ancestors, foot_points, tail_point, unit
 from .name_map import _KNEE, bend_index
 
 __all__ = ["Leg", "find_legs", "ancestors", "LegCalibration", "leg_contacts", "ground",
@@ -51,15 +51,6 @@ def tail_points(skeleton, mats):
     out = np.full((len(skeleton), 3), np.nan)
     for j in np.flatnonzero(np.all(np.isfinite(skeleton.tails), axis=1)):
         out[j] = tail_point(skeleton, mats[None], j)[0]
-    return out
-
-
-def ancestors(skeleton, j):
-    """Joint ``j`` and its ancestors up to the root, in that order."""
-    out = []
-    while j >= 0:
-        out.append(int(j))
-        j = skeleton.parents[j]
     return out
 
 

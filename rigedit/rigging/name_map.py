@@ -22,7 +22,8 @@ import numpy as np
 from ..errors import RigFileError
 
 __all__ = ["normalise_name", "find_slots", "auto_map", "name_pairs", "load_map", "save_map",
-           "bend_index", "interior_map", "LIMB_SLOTS"]
+           "bend_index", "interior_map", "finger_pairs", "FINGERS", "LIMB_SLOTS",
+           "BODY_PARTS", "unmapped_parts"]
 
 LIMB_SLOTS = ("clavicle", "upper_arm", "forearm", "hand", "thigh", "shin", "foot", "toe")
 _NOISE = {"joint", "jnt", "bone", "skeleton", "def", "bip01", "bip001", "mixamorig", "end", "j",
@@ -31,6 +32,9 @@ _SIDES = {"l": "L", "left": "L", "r": "R", "right": "R"}
 _KNEE = {"leg", "lowerleg", "lowleg", "knee", "shin", "calf", "crus"}
 _ELBOW = {"forearm", "lowerarm", "elbow"}
 _HIPS = {"hips", "hip", "pelvis"}
+#: Prefixes a rig puts on every joint (Character Creator / iClone's ``CC_Base_``, 3ds Max
+#: biped's ``Bip01 ``), dropped before the name is read.
+_PREFIX = re.compile(r"^(CC_Base_|RL_|Bip0*1[ _]|Bip001[ _])", re.IGNORECASE)
 _BODY_WORDS = ("hand", "foot", "fingers", "finger", "thumb", "hip", "hipjoint", "toe", "arm",
                "leg", "shoulder", "collar", "upleg", "foreArm")
 
@@ -56,7 +60,7 @@ def normalise_name(name):
     >>> normalise_name("leg_joint_R_2")
     ('R', 'leg')
     """
-    name = name.split(":")[-1].split("|")[-1]
+    name = _PREFIX.sub("", name.split(":")[-1].split("|")[-1])
     tokens = []
     for part in re.split(r"[\s_.\-]+", name):
         # camelCase and a capital side letter glued to a word: "LHipJoint" -> L, Hip, Joint
@@ -86,6 +90,15 @@ def _subtree_stats(skeleton, points):
         if p >= 0:
             lo[p], hi[p] = min(lo[p], lo[j]), max(hi[p], hi[j])
     return lo, hi
+
+
+def _figure_joints(skeleton):
+    """Joints from the first branching joint (or the last joint of a chain) down: the ones
+    above it only carry the figure."""
+    j = int(np.flatnonzero(skeleton.parents < 0)[0])
+    while len(skeleton.children(j)) == 1:
+        j = int(skeleton.children(j)[0])
+    return skeleton.subtree(j)
 
 
 def _chain(skeleton, start, score):
@@ -137,7 +150,9 @@ def find_slots(skeleton, points, what="skeleton"):
     """
     points = np.asarray(points, dtype=np.float64)
     n = len(skeleton)
-    size = float(np.ptp(points, axis=0).max()) or 1.0
+    # the figure's size, without the joints above its first branch: a carrier root (Bandai's
+    # joint_Root, iClone's RL_BoneRoot) may stand metres from the figure
+    size = float(np.ptp(points[_figure_joints(skeleton)], axis=0).max()) or 1.0
     lo, hi = _subtree_stats(skeleton, points)
     count = np.ones(n)
     reach = np.zeros(n)  # furthest distance from each joint within its subtree
@@ -151,10 +166,23 @@ def find_slots(skeleton, points, what="skeleton"):
             reach[a] = max(reach[a], np.linalg.norm(points[j] - points[a]))
             a = skeleton.parents[a]
     hips = None
+
+    def going_down(j):
+        return [c for c in skeleton.children(j)
+                if lo[c] < points[j, 1] - 0.25 * size and count[c] >= 2]
+
     for j in range(n):
         kids = skeleton.children(j)
-        down = [c for c in kids if lo[c] < points[j, 1] - 0.25 * size and count[c] >= 2]
+        down = going_down(j)
         up = [c for c in kids if hi[c] > points[j, 1] + 0.15 * size]
+        if len(down) < 2 and up:
+            # the legs may hang from a pelvis joint below the hips (iClone's CC_Base_Pelvis:
+            # the hips' child with the two legs and nothing going up)
+            for c in down:
+                if len(going_down(c)) >= 2 and not any(hi[k] > points[j, 1] + 0.15 * size
+                                                        for k in skeleton.children(c)):
+                    down = going_down(c)
+                    break
         if len(down) >= 2 and up:
             hips, legs = j, sorted(down, key=lambda c: lo[c])[:2]
             spine_start = max(up, key=lambda c: hi[c])
@@ -162,7 +190,9 @@ def find_slots(skeleton, points, what="skeleton"):
     if hips is None:
         raise ValueError(f"{what}: expected a humanoid with two legs (two joint chains going "
                          f"down from the hips) and a spine, found no such joint")
-    leg_chains = [_chain(skeleton, c, -lo) for c in legs]
+    # down the child with the most joints below it (the foot and toes, not a twist or share
+    # helper bone beside them), the lowest on a tie
+    leg_chains = [_chain(skeleton, c, count * 4 * size - lo) for c in legs]
     slots = {"hips": hips}
     spine = [hips] + _chain(skeleton, spine_start, hi)
     chest, arms = None, []
@@ -282,9 +312,66 @@ def auto_map(src_skeleton, src_points, tgt_skeleton, tgt_points, src_what="sourc
     pairs = [(s_slots[k], t_slots[k]) for k in t_slots if k in s_slots]
     for name in ("spine", "neck"):
         pairs += interior_map(s_chains[name], src_points, t_chains[name], tgt_points)
+    for side in "LR":
+        pairs += finger_pairs(src_skeleton, s_slots[f"hand_{side}"], tgt_skeleton,
+                              t_slots[f"hand_{side}"])
     mapping = {src_skeleton.names[a]: tgt_skeleton.names[b] for a, b in pairs}
     mapping.update(name_pairs(src_skeleton, tgt_skeleton, mapping))
     return mapping
+
+
+#: Finger names, in the order they are looked for in a joint's base word ("mid" after
+#: "middle"; Mixamo's "handindex", iClone's "index", Blender's "f_index").
+FINGERS = (("thumb", ("thumb",)), ("index", ("index", "pointer")),
+           ("middle", ("middle", "mid")), ("ring", ("ring",)),
+           ("pinky", ("pinky", "little", "small")))
+
+
+def _finger_runs(skeleton, hand):
+    """Each finger below ``hand``: {finger: [joints from its base out]} for the children
+    runs whose names say which finger (down the child with the most joints below it)."""
+    out = {}
+    for c in skeleton.children(hand):
+        run = [int(c)]
+        while len(skeleton.children(run[-1])):
+            kids = skeleton.children(run[-1])
+            run.append(int(max(kids, key=lambda k: len(skeleton.subtree(k)))))
+        words = " ".join(normalise_name(skeleton.names[j])[1] for j in run)
+        for finger, keys in FINGERS:
+            if any(k in words for k in keys):
+                # named twice (a palm joint and its finger both "middle"): the longer run
+                if finger not in out or len(run) > len(out[finger]):
+                    out[finger] = run
+                break
+    return out
+
+
+def finger_pairs(src_skeleton, src_hand, tgt_skeleton, tgt_hand):
+    """The finger joints of two hands paired: the same finger (by name: thumb, index,
+    middle, ring, pinky) on both, joint by joint from the hand out, by the numbers in their
+    names where both have them (Mixamo's ``Index1..4`` and iClone's ``Index1..3`` pair 1-3
+    and leave Mixamo's tip), else in order.
+
+    Returns
+    -------
+    pairs : list of (int, int)
+        Source joint, target joint; empty when either hand has no named fingers.
+    """
+    def number(sk, j):
+        digits = re.findall(r"\d+", sk.names[j].split(":")[-1])
+        return int(digits[-1]) if digits else None
+
+    s_runs, t_runs = _finger_runs(src_skeleton, src_hand), _finger_runs(tgt_skeleton, tgt_hand)
+    pairs = []
+    for finger in s_runs.keys() & t_runs.keys():
+        a, b = s_runs[finger], t_runs[finger]
+        na = [number(src_skeleton, j) for j in a]
+        nb = [number(tgt_skeleton, j) for j in b]
+        if None not in na + nb and len(set(na)) == len(na) and len(set(nb)) == len(nb):
+            pairs += [(a[na.index(k)], b[nb.index(k)]) for k in sorted(set(na) & set(nb))]
+        else:
+            pairs += list(zip(a, b))
+    return pairs
 
 
 def name_pairs(src_skeleton, tgt_skeleton, taken=None):
@@ -329,6 +416,54 @@ def name_pairs(src_skeleton, tgt_skeleton, taken=None):
                 out[s_keys[k][0]] = cand[0]
                 s_used.add(s_keys[k][0])
                 t_used.add(cand[0])
+    return out
+
+
+#: The parts of a humanoid a map must reach, each by the slots that make it.
+BODY_PARTS = (("left arm", ("upper_arm_L", "forearm_L", "hand_L")),
+              ("right arm", ("upper_arm_R", "forearm_R", "hand_R")),
+              ("left leg", ("thigh_L", "shin_L", "foot_L")),
+              ("right leg", ("thigh_R", "shin_R", "foot_R")),
+              ("spine", ("chest",)), ("head", ("head",)))
+
+
+def unmapped_parts(calibration, mapped):
+    """The parts of the target a joint map leaves (partly) unmapped.
+
+    Parameters
+    ----------
+    calibration : Calibration or LegCalibration
+        The target's.
+    mapped : iterable of int
+        The target joints the map reaches.
+
+    Returns
+    -------
+    parts : list of str
+        Humanoids (whatever calibrated the pair): ``"left arm"``, ``"right leg"``,
+        ``"spine"``, ``"head"``, each with the joints missing; other skeletons: each leg none of whose joints is mapped (by its
+        foot) and the spine (hips to chest). Empty when everything is reached.
+    """
+    mapped = set(mapped)
+    sk = calibration.skeleton
+    out = []
+    slots = getattr(calibration, "slots", None)
+    if slots is None:  # calibrated by its legs (the source was no humanoid): is it one?
+        try:
+            slots = find_slots(sk, calibration.points)[0]
+        except ValueError:
+            slots = None
+    if slots is not None:
+        for part, names in BODY_PARTS:
+            missing = [sk.names[slots[k]] for k in names if k in slots and slots[k] not in mapped]
+            if missing:
+                out.append(f"{part} ({', '.join(missing)})")
+        return out
+    for leg in calibration.legs:
+        if not mapped & set(leg.chain):
+            out.append(f"the leg of {sk.names[leg.contact]}")
+    if calibration.chest is not None and calibration.chest not in mapped:
+        out.append(f"spine ({sk.names[calibration.chest]})")
     return out
 
 
