@@ -47,40 +47,74 @@ def test_small_holes_pass_and_are_reported(body):
     assert c.lines()[1] == f"holes: 1 hole, the largest {100 * c.holes[0]:.1f}% of the size across"
 
 
-def test_big_hole_is_one_error_naming_the_file(body):
+def test_no_back_is_one_error_naming_the_file(body):
     v, f = body
-    keep = v[f].mean(axis=1)[:, 2] > 0.0        # the front half only
+    keep = v[f].mean(axis=1)[:, 2] > 0.0        # the front half only: a shell, no volume
     with pytest.raises(RigFileError) as err:
         check_mesh(v, f[keep], "front.obj")
     msg = str(err.value)
-    assert msg.startswith("front.obj: 1 hole, the largest ")
-    assert "auto-rigging needs a closed mesh or nearly" in msg
+    assert msg.startswith("front.obj: no volume to place a skeleton in: only ")
+    assert "an open shell or sheet (open mesh: 1 hole, the largest " in msg
+
+
+def test_big_hole_goes_through_the_proxy(body):
+    v, f = body
+    keep = v[f].mean(axis=1)[:, 1] > 0.9        # the upper body, open at the waist
+    c = check_mesh(v, f[keep], "bust.obj")
+    assert c.proxy is not None and c.proxy_reason.startswith("open mesh: 1 hole, the largest")
+    pv, pf = c.embedding_mesh()
+    assert pv is c.proxy.vertices and pf is c.proxy.faces
+    # closed: every edge of the proxy is shared by an even number of its triangles
+    _, count = np.unique(np.sort(np.concatenate([pf[:, [0, 1]], pf[:, [1, 2]],
+                                                 pf[:, [2, 0]]]), axis=1), axis=0,
+                         return_counts=True)
+    assert np.all(count % 2 == 0)
+    assert c.lines()[-1].startswith("proxy: open mesh: 1 hole, the largest ")
+    assert "embedded in a watertight proxy of " in c.lines()[-1]
+
+
+def test_closed_mesh_keeps_the_fast_path(body):
+    c = check_mesh(*body, "human.obj")
+    assert c.proxy is None and c.proxy_reason == ""
+    pv, pf = c.embedding_mesh()
+    assert len(pv) == len(c.vertices) and len(pf) == len(c.faces)
 
 
 def test_small_parts_ride_along_outside_the_embedding(body):
     v, f = body
     eye, eye_f = _sphere(60, centre=(0.03, 1.65, 0.1), radius=0.01)
-    big, big_f = _sphere(300, centre=(2.0, 1.0, 0.0), radius=0.4, seed=1)
-    verts = np.vstack([v, eye, big])
-    faces = np.vstack([f, eye_f + len(v), big_f + len(v) + len(eye)])
+    verts = np.vstack([v, eye])
+    faces = np.vstack([f, eye_f + len(v)])
     c = check_mesh(verts, faces, "parts.obj")
-    assert len(c.part_shares) == 3
-    # the eye is left out of the embedding, the big ball (over 1% of the area) is not
-    assert c.body.sum() == len(f) + len(big_f)
-    assert "3 parts" in c.lines()[3] and "1 small ones" in c.lines()[3]
+    assert len(c.part_shares) == 2 and c.proxy is None
+    # the eye is left out of the embedding
+    assert c.body.sum() == len(f)
+    assert "2 parts" in c.lines()[3] and "1 small ones" in c.lines()[3]
+
+
+def test_big_parts_go_through_the_proxy(body):
+    v, f = body
+    big, big_f = _sphere(300, centre=(0.0, 1.0, -0.3), radius=0.15, seed=1)  # a backpack
+    c = check_mesh(np.vstack([v, big]), np.vstack([f, big_f + len(v)]), "pack.obj")
+    assert c.proxy is not None
+    assert "2 separate parts over 1% of the area each" in c.proxy_reason
+    assert "all in the proxy" in c.lines()[3]
 
 
 def test_scatter_of_pieces_and_soup_are_errors():
     pieces = [_sphere(20, centre=(3.0 * i, 0, 0), radius=1.0, seed=i) for i in range(12)]
     v = np.vstack([p[0] for p in pieces])
     f = np.vstack([p[1] + 20 * i for i, p in enumerate(pieces)])
-    with pytest.raises(RigFileError, match=r"scatter.obj: 12 separate pieces, the largest only"):
+    with pytest.raises(RigFileError, match=r"scatter.obj: the volume falls into 12 separate "
+                                           r"pieces, the largest only"):
         check_mesh(v, f, "scatter.obj")
-    # one edge shared by many fins: a triangle soup, no inside
-    fins = np.array([[0, 1, 2 + i] for i in range(40)])
-    ang = np.linspace(0, np.pi, 40)
-    pts = np.vstack([[0, 0, 0], [0, 1, 0], np.c_[np.cos(ang), np.full(40, 0.5), np.sin(ang)]])
-    with pytest.raises(RigFileError, match="soup.obj: .*holes?|soup.obj: .*shared by more"):
+    # fins round one edge: a non-manifold soup of sheets, no inside (a dense fan of fins
+    # would enclose one, as hair cards do)
+    fins = np.array([[0, 1, 2 + i] for i in range(4)])
+    ang = np.linspace(0, np.pi, 4)
+    pts = np.vstack([[0, 0, 0], [0, 1, 0], np.c_[np.cos(ang), np.full(4, 0.5), np.sin(ang)]])
+    with pytest.raises(RigFileError, match="soup.obj: no volume to place a skeleton in: .*"
+                                           "shared by more than two triangles"):
         check_mesh(pts, fins, "soup.obj")
 
 

@@ -257,7 +257,7 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
 
     t0 = time.perf_counter()
     band("orient")(0.0)
-    body_v, body_f = checks.vertices, checks.faces[checks.body]
+    body_v, body_f = checks.embedding_mesh()     # the body, or a watertight proxy of it
     orientation = orient(body_v, body_f, upright=upright(poses[0][0]), up=up,
                          forward=forward)
     place = _placement(vertices, orientation)

@@ -1,22 +1,25 @@
-"""Read and check a mesh to be auto-rigged: is it closed enough to have an inside?
+"""Read and check a mesh to be auto-rigged, and give the embedding a volume it can use.
 
-The embedding needs an inside and an outside (a distance field, medial spheres). A mesh
-qualifies when, after welding coincident vertices (glTF and OBJ split them at UV seams):
+The embedding needs an inside and an outside (a distance field, medial spheres). After
+welding coincident vertices (glTF and OBJ split them at UV seams), a mesh is embedded as it
+is (the fast path, unchanged for closed meshes) when:
 
-- it has faces (a point cloud has no inside);
 - it is closed or nearly so: every hole (a loop of boundary edges) is at most
   :data:`MAX_HOLE` (10%) of the mesh's size across (its largest bounding-box side; a hole's
   width is its perimeter / pi, a circle's diameter), and the holes together would be covered
-  by discs of at most :data:`MAX_OPEN_AREA` (5%) of the surface area: an open neck or eye
-  socket passes, a mesh without a back or a loose sheet does not;
-- at most :data:`MAX_NONMANIFOLD` (2%) of its edges are shared by more than two triangles
-  (a few are harmless; many mean a triangle soup with no consistent surface);
-- one body dominates: parts (connected pieces) are fine, eyes, teeth or buttons ride along,
-  but the largest part must hold at least :data:`MIN_MAIN_PART` (10%) of the surface area
-  (below that it is a scatter of pieces, not a character).
+  by discs of at most :data:`MAX_OPEN_AREA` (5%) of the surface area (ray parity votes
+  past such holes);
+- no edge is shared by more than two triangles (interior faces break ray parity);
+- one part holds the body: parts under :data:`SMALL_PART` (1%) of the area (eyes, teeth,
+  buttons) ride along outside the embedding (they get skin weights like the rest).
 
-Parts under :data:`SMALL_PART` (1%) of the area are left out of the embedding (they get
-skin weights like the rest); everything else is embedded as one volume.
+Any other mesh (open, non-manifold, several parts that may overlap or nest, interior faces,
+triangle soup) is embedded in a watertight proxy of its volume
+(:func:`rigedit.embedding.volume.volume_proxy`), built from all its parts; the skin weights
+stay on the real mesh. ``MeshCheck.proxy_reason`` says why, and the report says so in one
+line. Refused, naming the file: no faces (a point cloud), no triangle with an area, no
+volume even with holes closed (a flat or open sheet), or a proxy whose largest piece holds
+under :data:`MIN_MAIN_PART` (10%) of the volume (a scatter of pieces, not a character).
 """
 from __future__ import annotations
 
@@ -27,16 +30,16 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from ..embedding.volume import NoVolumeError, volume_proxy
 from ..errors import RigFileError
 from ..model import laplacian as lap
 from ..model.heat import WELD  # welded as the heat weights weld it
 
 __all__ = ["MeshCheck", "read_mesh", "check_mesh", "MAX_HOLE", "MAX_OPEN_AREA",
-           "MAX_NONMANIFOLD", "MIN_MAIN_PART", "SMALL_PART"]
+           "MIN_MAIN_PART", "SMALL_PART"]
 
 MAX_HOLE = 0.10
 MAX_OPEN_AREA = 0.05
-MAX_NONMANIFOLD = 0.02
 MIN_MAIN_PART = 0.10
 SMALL_PART = 0.01
 
@@ -62,6 +65,10 @@ class MeshCheck:
     edges : int
     part_shares : list[float]
         Each part's share of the surface area, largest first.
+    proxy : VolumeProxy or None
+        The watertight proxy the embedding uses instead of the mesh, when one is needed.
+    proxy_reason : str
+        Why the proxy was needed ("" without one).
     """
 
     vertices: np.ndarray
@@ -73,6 +80,14 @@ class MeshCheck:
     nonmanifold: int = 0
     edges: int = 0
     part_shares: list = field(default_factory=list)
+    proxy: object = None
+    proxy_reason: str = ""
+
+    def embedding_mesh(self):
+        """(vertices (P, 3), faces (Q, 3)) to embed: the proxy's, else the body parts'."""
+        if self.proxy is not None:
+            return self.proxy.vertices, self.proxy.faces
+        return self.vertices, self.faces[self.body]
 
     def lines(self):
         """Short human-readable lines for the CLI and the editor."""
@@ -82,11 +97,18 @@ class MeshCheck:
         small = sum(s < SMALL_PART for s in self.part_shares)
         parts = ("one part" if len(self.part_shares) == 1 else
                  f"{len(self.part_shares)} parts, the largest {100 * self.part_shares[0]:.0f}% "
-                 f"of the area, {small} small ones (under {100 * SMALL_PART:.0f}%) ride along "
-                 "outside the embedding")
-        return [f"mesh: {len(self.vertices)} vertices, {len(self.faces)} triangles (welded)",
-                f"holes: {holes}", f"non-manifold edges: {self.nonmanifold} of {self.edges}",
-                f"parts: {parts}"]
+                 f"of the area, " + ("all in the proxy" if self.proxy is not None else
+                                     f"{small} small ones (under {100 * SMALL_PART:.0f}%) "
+                                     "ride along outside the embedding"))
+        out = [f"mesh: {len(self.vertices)} vertices, {len(self.faces)} triangles (welded)",
+               f"holes: {holes}", f"non-manifold edges: {self.nonmanifold} of {self.edges}",
+               f"parts: {parts}"]
+        if self.proxy is not None:
+            p = self.proxy
+            out.append(f"proxy: {self.proxy_reason}; embedded in a watertight proxy of "
+                       f"{len(p.faces) / 1000:.0f}k triangles (cells {p.h:.3g} across, "
+                       f"{p.seconds:.1f} s)")
+        return out
 
 
 def read_mesh(path, with_surface=False):
@@ -163,6 +185,23 @@ def _holes(vertices, edges):
     return np.bincount(label[inv[:, 0]], weights=length, minlength=n)
 
 
+def _proxy_reasons(holes, open_area, nonmanifold, edges, part_shares):
+    """Why ray parity on the mesh itself cannot be trusted: one phrase per cause."""
+    out = []
+    if holes and (holes[0] > MAX_HOLE or open_area > MAX_OPEN_AREA):
+        out.append(f"open mesh: {len(holes)} hole{'s' * (len(holes) > 1)}, the largest "
+                   f"{100 * holes[0]:.0f}% of its size across, together "
+                   f"{100 * open_area:.0f}% of its surface")
+    if nonmanifold:
+        out.append(f"{nonmanifold} of {edges} edges shared by more than two triangles "
+                   "(interior faces, touching parts or a soup)")
+    body = sum(s >= SMALL_PART for s in part_shares)
+    if body > 1:
+        out.append(f"{body} separate parts over {100 * SMALL_PART:.0f}% of the area each "
+                   "(overlapping or nested parts have no single inside)")
+    return out
+
+
 def check_mesh(vertices, faces, path="mesh"):
     """Check that a mesh can be auto-rigged (see the module notes for what is accepted).
 
@@ -180,7 +219,8 @@ def check_mesh(vertices, faces, path="mesh"):
     Raises
     ------
     RigFileError
-        One message naming the file and what is wrong.
+        One message naming the file and what is wrong: no faces, no volume, a scatter of
+        pieces.
     """
     vertices = np.asarray(vertices, dtype=np.float64)
     faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
@@ -210,20 +250,18 @@ def check_mesh(vertices, faces, path="mesh"):
     order = np.argsort(-shares[present])
     res = MeshCheck(wv, wf, shares[label[wf[:, 0]]] >= SMALL_PART, size, holes, open_area,
                     nonmanifold, len(edges), list(shares[present][order]))
-    advice = ("auto-rigging needs a closed mesh or nearly (holes under "
-              f"{100 * MAX_HOLE:.0f}% of the size across, together under "
-              f"{100 * MAX_OPEN_AREA:.0f}% of the surface)")
-    if holes and (holes[0] > MAX_HOLE or open_area > MAX_OPEN_AREA):
-        raise RigFileError(path, f"{len(holes)} hole{'s' * (len(holes) > 1)}, the largest "
-                                 f"{100 * holes[0]:.0f}% of the mesh's size across, together "
-                                 f"{100 * open_area:.0f}% of its surface: {advice}")
-    if nonmanifold > MAX_NONMANIFOLD * len(edges):
-        raise RigFileError(path, f"{nonmanifold} of {len(edges)} edges are shared by more than "
-                                 "two triangles: auto-rigging needs a surface with an inside "
-                                 f"(at most {100 * MAX_NONMANIFOLD:.0f}% such edges)")
-    if res.part_shares[0] < MIN_MAIN_PART:
-        raise RigFileError(path, f"{len(res.part_shares)} separate pieces, the largest only "
-                                 f"{100 * res.part_shares[0]:.1f}% of the surface: "
-                                 "auto-rigging needs one body (small parts such as eyes may "
-                                 "ride along)")
+    reasons = _proxy_reasons(holes, open_area, nonmanifold, len(edges), res.part_shares)
+    if not reasons:
+        return res                  # the fast path: the mesh itself is embedded
+    try:
+        res.proxy = volume_proxy(wv, wf)
+    except NoVolumeError as exc:
+        raise RigFileError(path, f"no volume to place a skeleton in: {exc} "
+                                 f"({'; '.join(reasons)})") from None
+    res.proxy_reason = "; ".join(reasons)
+    if res.proxy.largest < MIN_MAIN_PART:
+        raise RigFileError(path, f"the volume falls into {res.proxy.pieces} separate pieces, "
+                                 f"the largest only "
+                                 f"{100 * res.proxy.largest:.1f}% of it: auto-rigging needs "
+                                 "one body (small parts such as eyes may ride along)")
     return res
