@@ -77,14 +77,15 @@ def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_fee
 
 
 def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", clips=True,
-            progress=None):
+            progress=None, hints=None):
     """Rig a static mesh: embed a template skeleton, bind it, give it the template's clips
-    (see :func:`rigedit.rigging.autorig.autorig`); ``rig.autorig_report`` says what was
-    decided (orientation, checks, stage times)."""
+    (see :func:`rigedit.rigging.autorig.autorig`; ``hints`` pins joints, {name: (x, y, z)}
+    in the mesh's coordinates); ``rig.autorig_report`` says what was decided (orientation,
+    checks, stage times)."""
     from .rigging.autorig import autorig as _autorig
 
     return _autorig(mesh, template=template, up=up, forward=forward, weights=weights,
-                    clips=clips, progress=progress)
+                    clips=clips, progress=progress, hints=hints)
 
 
 def save_rig(rig, path, clips=None):

@@ -258,6 +258,11 @@ def build_parser():
                         "--forward=-x; default: guessed)")
     s.add_argument("--method", default="heat", help="skin weights: heat (default) or idw")
     s.add_argument("--no-clips", action="store_true", help="do not retarget the template's clips")
+    s.add_argument("--hint", action="append", default=None, metavar="JOINT=x,y,z",
+                   help="pin a template joint at a point in the mesh file's coordinates "
+                        "(repeatable)")
+    s.add_argument("--hints", default=None, metavar="FILE.json",
+                   help="pin joints from a JSON object {joint: [x, y, z]} (--hint wins)")
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     s.add_argument("-o", "--output", required=True, metavar="RIG_FOLDER|OUT.glb")
     s.set_defaults(func=cmd_autorig)

@@ -76,3 +76,69 @@ def test_a_point_outside_the_mesh_is_one_error_naming_the_joint(humanoid):
     with pytest.raises(HintError, match="'Head'.*finite"):
         _embed(humanoid, humanoid.vertices, hints={"Head": [0.0, np.nan, 0.0]})
     assert issubclass(HintError, ValueError) and not issubclass(HintError, EmbeddingError)
+
+
+# ------------------------------------------------------------ rigedit.autorig, the CLI
+#: The bundled humanoid as a file would hold it: Z up, facing -X, centimetres, off-centre.
+TO_INPUT = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+SCALE, SHIFT = 100.0, np.array([250.0, -40.0, 13.0])
+
+
+def _foreign(points):
+    return (np.asarray(points) @ TO_INPUT.T) * SCALE + SHIFT
+
+
+def test_autorig_turns_hints_from_the_files_coordinates(humanoid):
+    import rigedit
+
+    sk = humanoid.skeleton
+    rest = sk.bind_matrices[:, :3, 3]
+    moved = rest[sk.index["LeftForeArm"]] + [0.0, 0.03, 0.0]   # an elbow a little higher
+    hints = {"LeftForeArm": _foreign(moved)}
+    rig = rigedit.autorig((_foreign(humanoid.vertices), humanoid.faces), up="z",
+                          forward="-x", weights="idw", clips=False, hints=hints)
+    m = rig.autorig_report.transform
+    expected = m[:3, :3] @ hints["LeftForeArm"] + m[:3, 3]
+    got = rig.skeleton.bind_matrices[rig.skeleton.index["LeftForeArm"], :3, 3]
+    assert np.allclose(got, expected, atol=1e-6)
+    # the file's point, turned back, is the elbow we meant (the rig stands in metres x 100)
+    assert np.allclose(np.linalg.solve(m[:3, :3], got - m[:3, 3]), hints["LeftForeArm"])
+
+
+def test_cli_hint_options(tmp_path, capsys, humanoid):
+    import json
+
+    from rigedit.cli import main
+    from rigedit.io.mesh import save_obj
+    from rigedit.rigging.autorig_command import read_hints
+
+    mesh = tmp_path / "man.obj"
+    save_obj(mesh, humanoid.vertices, humanoid.faces)
+    sk = humanoid.skeleton
+    hand = sk.bind_matrices[sk.index["LeftHand"], :3, 3]
+    hints = tmp_path / "hints.json"
+    hints.write_text(json.dumps({"LeftHand": [0.0, 0.0, 0.0], "Head": [0.0, 1.6, 0.0]}))
+    # --hint wins over the file
+    got = read_hints([f"LeftHand={hand[0]},{hand[1]},{hand[2]}"], str(hints))
+    assert got == {"LeftHand": list(hand), "Head": [0.0, 1.6, 0.0]}
+    assert read_hints(None, None) is None
+    out = tmp_path / "out"
+    common = ["--up", "y", "--forward", "z", "--method", "idw", "--no-clips", "-q", "-o"]
+    code = main(["autorig", str(mesh), "--hint", f"LeftHand={hand[0]},{hand[1] + 0.02},"
+                 f"{hand[2]}"] + common + [str(out)])
+    assert code == 0, capsys.readouterr().err
+    capsys.readouterr()
+    # bad hints: one line naming the joint (or the option, or the file), nothing written
+    cases = [(["--hint", "LeftElbow=0.5,1.4,0"], "'LeftElbow'"),
+             (["--hint", "Head=0,9,0"], "'Head' is outside the mesh"),
+             (["--hint", "Head=0,1.6"], "--hint 'Head=0,1.6': expected JOINT=x,y,z"),
+             (["--hints", str(tmp_path / "none.json")], "none.json: cannot read it")]
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"Head": [0, "up", 0]}))
+    cases.append((["--hints", str(bad)], "hint for joint 'Head': expected [x, y, z]"))
+    for extra, said in cases:
+        target = tmp_path / "bad_out"
+        code = main(["autorig", str(mesh)] + extra + common + [str(target)])
+        err = capsys.readouterr().err
+        assert code == 2 and err.count("\n") == 1 and said in err, (extra, err)
+        assert not target.exists()

@@ -5,7 +5,7 @@ inside a closed triangle mesh. Pure numpy/scipy.
 >>> emb = embed_skeleton(vertices, faces, template_skeleton)     # doctest: +SKIP
 >>> emb.positions                        # (J, 3), every template joint   # doctest: +SKIP
 """
-from .embed import Embedding, EmbeddingError, embed_skeleton
+from .embed import Embedding, EmbeddingError, HintError, embed_skeleton
 from .metric import cd_j2j
 
-__all__ = ["embed_skeleton", "Embedding", "EmbeddingError", "cd_j2j"]
+__all__ = ["embed_skeleton", "Embedding", "EmbeddingError", "HintError", "cd_j2j"]

@@ -78,8 +78,9 @@ def check_hints(hints, names, field=None):
         if field is not None:
             depth = float(field(p[None])[0])
             if depth <= -OUTSIDE_CELLS * field.h:   # the field holds -h far out
-                raise HintError(f"hint for joint {name!r} at ({p[0]:.4g}, {p[1]:.4g}, "
-                                f"{p[2]:.4g}) is outside the mesh")
+                # no coordinates: the caller may have turned the user's point into this frame
+                raise HintError(f"hint for joint {name!r} is outside the mesh (expected a "
+                                "point inside the body, or on its skin)")
         out[index[name]] = p
     return out
 

@@ -71,6 +71,11 @@ class AutorigReport:
     outside : list[str]
         Carried template joints with no geometry around them (collapsed by the embedding
         into their base's region): kept, for the clips, but not deforming.
+    embedded : (J, 3) float64
+        Every template joint as embedded, in the rig's coordinates (the editor's "Re-embed
+        around the joints I moved" compares the rest with it).
+    hints : dict[str, (3,) float64]
+        The joints pinned by hints, in the rig's coordinates.
     """
 
     source: str
@@ -84,6 +89,8 @@ class AutorigReport:
     clips: dict = field(default_factory=dict)
     template_pose: str = "rest"
     outside: list = field(default_factory=list)
+    embedded: np.ndarray = None
+    hints: dict = field(default_factory=dict)
 
     def lines(self):
         """The report as short lines (the CLI prints them)."""
@@ -198,8 +205,20 @@ def _placement(vertices, orientation):
     return m
 
 
+def _turned(hints, place):
+    """Hints in the input's coordinates -> the embedding's frame (``place``, (4, 4))."""
+    out = {}
+    for name, p in (hints or {}).items():
+        try:
+            out[name] = place[:3, :3] @ np.asarray(p, dtype=np.float64).reshape(3) + place[:3, 3]
+        except (TypeError, ValueError):
+            out[name] = p   # embed_skeleton names the joint and what is wrong
+    return out
+
+
 def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", clips=True,
-            progress=None):
+            progress=None, hints=None):
+
     """Rig a static mesh with a template skeleton (see the module notes).
 
     Parameters
@@ -217,6 +236,9 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
         Give the template's clips to the new character.
     progress : callable(fraction, stage), optional
         Called as the work advances; an exception it raises cancels.
+    hints : dict[str, (3,) float], optional
+        Template joint name -> where it must be, in the mesh's (the input's) coordinates:
+        those joints are pinned and the embedding places the others around them.
 
     Returns
     -------
@@ -229,7 +251,7 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
         Naming the mesh (or template) file and what is wrong: not closed enough, no limbs
         like the template's, a template that is not a skeleton.
     """
-    from ..embedding import EmbeddingError, embed_skeleton
+    from ..embedding import EmbeddingError, HintError, embed_skeleton
     from ..model.weights import compute_weights
     from ..rig import Rig
 
@@ -275,8 +297,10 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     for t_sk, t_pose in poses:   # the first standing pose of the template that fits
         try:
             emb = embed_skeleton(emb_v, remap[body_f], t_sk, progress=band("embedding"),
-                                 template_mesh=t_mesh)
+                                 template_mesh=t_mesh, hints=_turned(hints, place))
             break
+        except HintError as exc:   # an unknown joint, a point outside the mesh
+            raise RigFileError(source, str(exc)) from None
         except EmbeddingError as exc:
             first = first or exc
     if emb is None:
@@ -319,5 +343,7 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     rig.autorig_report = AutorigReport(source, t_name, orientation, place, checks, seconds,
                                        emb.cost, list(emb.placed), clip_notes, t_pose,
                                        list(emb.outside))
+    rig.autorig_report.embedded = np.array(emb.positions)
+    rig.autorig_report.hints = _turned(hints, place)
     rig.notes["autorig"] = (f"template {t_name}; orientation {orientation.describe()}")
     return rig

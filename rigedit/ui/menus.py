@@ -42,6 +42,12 @@ class MenusMixin:
         m.addAction(self._action("&Auto-rig mesh...", self.autorig.run, "Ctrl+Shift+A",
                                  tip="Embed a template skeleton (humanoid, quadruped or a "
                                      "skeleton file) in a mesh and open it in bind mode"))
+        from .reembed import ReembedAction
+
+        self.reembed = ReembedAction(self)
+        m.addAction(self._action("Re-embed around the joints I moved", self.reembed.run,
+                                 tip="After an auto-rig: pin the joints dragged in bind mode "
+                                     "and place the others again around them"))
 
         self.motion_import = ImportMotion(self)
         m.addAction(self._action("Import motion onto this character...", self.motion_import.run,
