@@ -93,3 +93,105 @@ def test_xbot_walk_onto_itself():
     want = _positions(xbot, xbot.clips["walk"], raw.times)
     got = _positions(xbot, raw.clip, raw.times)
     assert np.abs(got - want).max() < 0.01 * np.ptp(want[..., 1])
+
+
+def _ancestors(sk, j):
+    out = []
+    while j >= 0:
+        out.append(j)
+        j = sk.parents[j]
+    return out
+
+
+def _shared(*parts):
+    return DATA.joinpath(*parts)
+
+
+#: Every character with clips in the shared data and the bundled ones, with its clips; the
+#: BVH skeletons onto themselves. (RiggedSimple, RobotExpressive and the horse are left out:
+#: no legs that reach the floor are found in them, so nothing retargets onto them yet: their
+#: feet are IK targets under the root.)
+CHARACTERS = [(XBOT, c) for c in ("walk", "run", "idle", "agree", "headShake", "sad_pose",
+                                  "sneak_pose")] + [
+    pytest.param((_shared("khronos-gltf", "CesiumMan.glb"), None), marks=pytest.mark.xfail(
+        reason="the floor: the motion's (5th percentile of its lowest foot joint) is 14.5 mm "
+               "below the rest's, so the retarget lowers the figure by that (retarget.py's "
+               "floor rule)", strict=False)),
+    (_shared("khronos-gltf", "RiggedFigure.glb"), None),
+    ("humanoid", "walk"), ("humanoid", "wave"), ("humanoid", "idle"),
+    ("quadruped", "walk"), ("quadruped", "run"),
+    (_shared("bvh-bandai", "dataset-1_walk_normal_002.bvh"), None),
+    (_shared("bvh-library", "bandai-2", "dataset-2_walk_active_001.bvh"), None),
+    (_shared("bvh-library", "cmu-iclone", "005_01.bvh"), None),
+    (_shared("bvh-library", "cmu-iclone", "002_01.bvh"), None),
+]
+
+
+def _ids(case):
+    path, clip = case
+    return f"{Path(str(path)).stem}-{clip}" if clip else Path(str(path)).stem
+
+
+_RIGS = {}
+
+
+def _rig(path):
+    if path not in _RIGS:
+        _RIGS[path] = _load(path)
+    return _RIGS[path]
+
+
+def _groups(res):
+    return [g for g in res.target_calibration.groups]
+
+
+@pytest.mark.parametrize("case", CHARACTERS, ids=_ids)
+def test_identity_before_the_foot_clean_up(case):
+    """Every mapped bone, feet included, points where it did (0.5 degrees; measured 0.0001
+    at most) and every joint is where it was, up to the floor's vertical shift (the motion's
+    floor, a low percentile of its feet, onto the rest's: measured 2.9 mm on Xbot's walk;
+    the BVH rests do not stand on the motion's floor)."""
+    path, clip = case
+    rig = _rig(path)
+    clip = clip or next(iter(rig.clips))
+    res = retarget_result(rig, clip, rig, clean_feet=False)
+    assert res.facing_degrees == 0 and abs(res.scale - 1) < 1e-9
+    err = direction_errors(res)
+    assert max(v for g, v in err.items() if np.isfinite(v)) < 0.5, err
+    sk = rig.skeleton
+    want = _positions(rig, rig.clips[clip], res.times)
+    got = _positions(rig, res.clip, res.times)
+    # animated translations of joints other than the hips and roots are not transferred
+    # (glTF exports key them on every joint; Xbot's sneak_pose moves its thighs' offsets
+    # 1-2 cm): each joint may be off by what its ancestors' offsets move, and no more
+    hips = res.target_calibration.hips
+    moved = np.zeros(len(sk))
+    for (joint, channel), tr in rig.clips[clip].tracks.items():
+        j = sk.index[joint]
+        if channel == "translation" and j != hips and sk.parents[j] >= 0:
+            scale = np.linalg.norm(model_stack(rig.skeleton, rig.clips[clip], res.times[:1])
+                                   [0, sk.parents[j], :3, 0])
+            moved[j] = np.linalg.norm(tr.values - sk.rest_translation[j], axis=1).max() * scale
+    slack = np.array([sum(moved[a] for a in _ancestors(sk, j)) for j in range(len(sk))])
+    # a root above the hips carries the travel its own way
+    carried = [j for j in range(len(sk)) if sk.parents[j] < 0 and j != hips]
+    body = np.setdiff1d(np.arange(len(sk)), carried)
+    delta = got[:, body] - want[:, body]
+    shift = np.median(delta[:, [list(body).index(hips)], 1])
+    tol = 1e-4 * np.ptp(want[..., 1]) + 1e-6 + 2 * slack[body]
+    assert (np.abs(delta[..., [0, 2]]).max(axis=(0, 2)) < tol).all()
+    assert (np.abs(delta[..., 1] - shift).max(axis=0) < tol).all()
+    if res.source_calibration.source == "rest" and res.target_calibration.joint_floor > -0.05:
+        assert abs(shift) < 0.01  # a standing rest: the feet stay on their floor
+
+
+@pytest.mark.parametrize("case", [c.values[0] if hasattr(c, "marks") else c
+                                  for c in CHARACTERS if "bvh" not in str(c)], ids=_ids)
+def test_identity_after_the_foot_clean_up_keeps_the_upper_body(case):
+    """With the clean-up, arms, spine, head and fingers still point where they did."""
+    path, clip = case
+    rig = _rig(path)
+    clip = clip or next(iter(rig.clips))
+    err = direction_errors(retarget_result(rig, clip, rig))
+    upper = [g for g in ("arms", "spine", "head", "fingers", "tail") if g in err]
+    assert max(err[g] for g in upper if np.isfinite(err[g])) < 0.5, err

@@ -9,7 +9,11 @@ from .calibrate import rotations_of, swing, unit
 from .chains import distribute_bend
 from .limbs import ancestors
 
-__all__ = ["transfer_rotations", "end_spec", "end_points"]
+__all__ = ["transfer_rotations", "end_spec", "end_points", "FLAT_AGREE"]
+
+#: Degrees within which the source's rest foot and its median foot during contacts are taken
+#: for the same flat foot (then the rest's is used).
+FLAT_AGREE = 15.0
 
 
 def end_spec(skeleton, calib, j, mapped, next_in_chain):
@@ -105,7 +109,17 @@ def transfer_rotations(src, tgt, inverse, smats, scal, rf, contact):
             want = end_points(smats, s_spec) - smats[:, s, :3, 3]
             if j in flat:
                 pitch = _pitch(want[flat[j]]) if flat[j].any() else _pitch(vs)
-                want = _pitched(want, float(np.median(pitch)) - _pitch(vt))
+                s_flat = float(np.median(pitch))
+                # a standing rest whose foot agrees with the clip's flat foot is the better
+                # measure of it (the median over contacts carries the foot's roll and curled
+                # toes: Xbot's toes stand 5-7 degrees up in its own clips): so a character's
+                # own clip keeps its feet exactly
+                if src.source == "rest" and abs(s_flat - _pitch(vs)) < np.radians(FLAT_AGREE):
+                    s_flat = float(_pitch(vs))
+                # a target calibrated on a clip's frame (its rest does not stand) has no known
+                # flat foot: the foot points as the source's
+                t_flat = _pitch(vt) if tgt.source == "rest" else s_flat
+                want = _pitched(want, s_flat - t_flat)
             r = swing(r @ u, want) @ r
             pairs.append((j, t_spec, s, s_spec))
         rot[:, j] = r
