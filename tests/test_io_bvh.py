@@ -7,7 +7,7 @@ import pytest
 
 import rigedit
 from rigedit.errors import RigFileError
-from rigedit.io.bvh import BvhUnitsWarning, guess_unit, load_bvh
+from rigedit.io.bvh import BvhUnitsWarning, believable, guess_unit, load_bvh
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 FILES = ["bvh-cmu/131_01.bvh", "bvh-bandai/dataset-1_walk_normal_002.bvh",
@@ -324,3 +324,35 @@ def test_several_roots_and_joints_without_channels_round_trip(tmp_path):
     for t in (0.0, 0.1):
         np.testing.assert_allclose(back.joint_matrices(back.clips["take"].sample(t))[:, :3, 3],
                                    rig.joint_matrices(clip.sample(t))[:, :3, 3], atol=1e-8)
+
+
+@pytest.mark.parametrize("size,unit", [(125, "centimetres"), (215, "centimetres"),
+                                        (48, "inches"), (22, "CMU units (1/0.45 inch)")])
+def test_unit_guess_takes_the_unit_that_makes_a_human(size, unit):
+    """Within 1.2-2.2 m at most one unit fits: it wins even far from 1.7 m (125 cm used to
+    read as inches: 3.2 m)."""
+    name, scale = guess_unit(size)
+    assert name == unit and believable(size * scale)
+
+
+def test_unit_guess_outside_a_human_size_says_not_sure(tmp_path):
+    """A figure 4 m in centimetres or 0.4 m in millimetres: no unit makes it a human."""
+    text = SMALL.replace("OFFSET 0 100 0", "OFFSET 0 330 0")   # about 420 units across
+    with pytest.warns(BvhUnitsWarning, match="NOT SURE: no unit makes it a human's 1.2-2.2 m"):
+        rig = load_bvh(write(tmp_path, text))
+    assert "NOT SURE" in rig.notes["units"] and "units across): 4.2" in rig.notes["units"]
+
+
+@pytest.mark.parametrize("name", sorted(str(p.relative_to(DATA))
+                                        for p in DATA.glob("**/*.bvh")))
+def test_every_shared_bvh_is_read_as_a_human(name):
+    """Every shared BVH (Bandai's dataset-2 walk with its carrier 5 m away included) reads
+    as centimetres or CMU units, a human's size, unflagged; a carrier root is named."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rig = load_bvh(shared(name))
+    note = rig.notes["units"]
+    assert ("centimetres" in note or "CMU units" in note) and "NOT SURE" not in note, note
+    assert len(caught) == 1
+    root = rig.skeleton.names[0]
+    assert ("carrier" in rig.notes) == (root in ("joint_Root", "RL_BoneRoot")), rig.notes

@@ -13,7 +13,8 @@ from rigedit.io.bvh_write import bvh_frame_times, save_bvh
 from rigedit.model import Skeleton
 from rigedit.model.transforms import euler_to_quat
 from rigedit.rig import Rig
-from test_io_bvh import FILES, shared
+from bvh_figures import humanoid_bvh
+from test_io_bvh import DATA, FILES, shared
 
 
 def positions_per_frame(rig, clip, times):
@@ -152,3 +153,57 @@ def test_source_rotation_orders_are_kept(tmp_path):
     back = load_bvh(out, scale=0.01)
     clip = rig.clips["take"]
     assert_same_motion(rig, clip, back, bvh_frame_times(clip)[0])
+
+
+SHARED_BVH = sorted(str(p.relative_to(DATA)) for p in DATA.glob("**/*.bvh"))
+
+
+def _guessed(path):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rig = load_bvh(path)
+    return rig, [str(w.message) for w in caught]
+
+
+@pytest.mark.parametrize("name", SHARED_BVH)
+def test_round_trip_with_guessed_units_keeps_the_size(name, tmp_path):
+    """Read with the unit guessed, written (centimetres), read again with the unit guessed:
+    the same joint positions in metres (the issue: a carrier-root walk came back 8.5 times
+    its size)."""
+    rig, _ = _guessed(shared(name))
+    out = tmp_path / "out.bvh"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")   # a human's size: no warning on writing
+        save_bvh(rig, out)
+    back, said = _guessed(out)
+    assert "guessed centimetres" in said[0] and "NOT SURE" not in said[0], said
+    clip = rig.clips["take"]
+    assert_same_motion(rig, clip, back, bvh_frame_times(clip)[0])
+
+
+def test_round_trip_of_a_carrier_root_figure(tmp_path):
+    """A carrier root at the origin, the figure 5.4 m from it, written in millimetres: read,
+    written, read again, all with guessed units, the size is kept."""
+    src = tmp_path / "far.bvh"
+    src.write_text(humanoid_bvh(carrier="joint_Root", start=(0, 0, -540), unit=10.0))
+    rig, said = _guessed(src)
+    assert "guessed millimetres" in said[0]
+    out = tmp_path / "back.bvh"
+    save_bvh(rig, out)
+    back, said = _guessed(out)
+    assert "guessed centimetres" in said[0] and "carrier root joint_Root" in said[0]
+    clip = rig.clips["take"]
+    assert_same_motion(rig, clip, back, bvh_frame_times(clip)[0])
+    assert not back.skeleton.deform[back.skeleton.joint_index("joint_Root")]
+
+
+def test_writing_a_figure_that_is_not_human_sized_warns(tmp_path):
+    rig = rigedit.load_rig("quadruped")   # made four times its size below
+    sk = rig.skeleton
+    big = Skeleton(sk.names, sk.parents, sk.rest_translation * 4, sk.rest_rotation,
+                   tails=sk.tails * 4)
+    giant = Rig(big, np.zeros((0, 3)), np.zeros((0, 3), int), np.zeros((0, 1), int),
+                np.zeros((0, 1)), {})
+    with pytest.warns(UserWarning, match="not a human's 1.2-2.2 m: read it back with "
+                                         "scale=0.01"):
+        save_bvh(giant, tmp_path / "giant.bvh")

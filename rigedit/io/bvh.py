@@ -20,9 +20,16 @@ The clip (named ``take``) has one key per frame at ``k * dt``: a rotation track 
 for every joint with a rotation channel, a translation track (``linear``) for every joint
 with a position channel. It does not loop. The rest pose is the OFFSETs with no rotation.
 
+Carrier roots (:mod:`rigedit.model.carrier`: a root above the hips that only carries the
+figure, Bandai's ``joint_Root``, iClone's ``RL_BoneRoot``) are found on frames sampled over
+the clip; they deform nothing (``Skeleton.deform``), ``rig.notes["carrier"]`` names them,
+and the figure's size leaves them out.
+
 Units: BVH has none. ``scale`` (metres per file unit) converts; when it is omitted the unit
-is guessed from the figure's size at its first frame (see :func:`guess_unit`) and the guess is
-reported in a :class:`BvhUnitsWarning` and in ``rig.notes["units"]``. Frames: BVH is
+is guessed from the figure's size (its largest extent over sampled frames, 90th percentile,
+carrier roots left out; see :func:`guess_unit`): the unit that makes it a human's 1.2-2.2 m, else the nearest
+and NOT SURE. The guess is reported in a :class:`BvhUnitsWarning` and in
+``rig.notes["units"]``. Frames: BVH is
 conventionally Y up, rigedit's own convention, so axes are kept as they are
 (``rig.notes["frames"]`` says so).
 """
@@ -36,13 +43,14 @@ import numpy as np
 
 from ..animation.clip import Clip, Track
 from ..errors import RigFileError
+from ..model.carrier import carrier_joints, carrier_note
 from ..model.skeleton import Skeleton
 from ..model.transforms import compose_trs, quat_multiply
 from ..rig import Rig
 from .bvh_parse import parse_bvh
 
-__all__ = ["load_bvh", "save_bvh", "parse_bvh", "guess_unit", "euler_channels_to_quats",
-           "BvhUnitsWarning", "UNITS", "CLIP_NAME"]
+__all__ = ["load_bvh", "save_bvh", "parse_bvh", "guess_unit", "believable",
+           "euler_channels_to_quats", "BvhUnitsWarning", "UNITS", "HUMAN_SIZE", "CLIP_NAME"]
 
 CLIP_NAME = "take"
 #: Units a BVH figure may be written in: name -> metres per unit. "CMU" is the unit of the
@@ -51,42 +59,24 @@ UNITS = {"metres": 1.0, "centimetres": 0.01, "millimetres": 0.001, "inches": 0.0
          "CMU units (1/0.45 inch)": 0.0254 / 0.45}
 #: The figure height a guess aims at (an adult human), metres.
 TYPICAL_HEIGHT = 1.7
+#: The sizes (largest extent, metres) a human figure may have: outside, a guess is flagged.
+HUMAN_SIZE = (1.2, 2.2)
+#: Frames looked at, evenly spaced, to find carrier roots and to measure the figure.
+SAMPLED_FRAMES = 32
 
 
 class BvhUnitsWarning(UserWarning):
     """A BVH file's unit was guessed (no ``scale`` given)."""
 
 
-def _rest_points(parents, offsets, ends):
-    """Model-space heads and End Site points at rest (no rotations: offsets add up)."""
-    heads = np.zeros_like(offsets)
-    for j, p in enumerate(parents):
-        heads[j] = offsets[j] + (heads[p] if p >= 0 else 0.0)
-    tips = [heads[j] + e for j, e in enumerate(ends) if e is not None]
-    return heads, np.array(tips).reshape(-1, 3)
-
-
-def _deforming(parents, heads, tips):
-    """(J,) bool: False for a root that only carries the figure (Bandai's ``joint_Root``): a
-    root with one child, at the figure's lowest level, so its "bone" would run from the floor
-    up to the hips."""
-    deform = np.ones(len(parents), dtype=bool)
-    points = np.vstack([heads, tips])
-    height = float(np.ptp(points[:, 1])) or 1.0
-    for r in np.flatnonzero(parents < 0):
-        if (np.sum(parents == r) == 1
-                and heads[r, 1] - points[:, 1].min() < 0.05 * height):
-            deform[r] = False
-    return deform
-
-
 def guess_unit(size):
-    """The unit under which a figure ``size`` file units tall is nearest an adult's height.
+    """The unit under which a figure ``size`` file units across is an adult's size.
 
     Parameters
     ----------
     size : float
-        The largest extent of the figure at rest (height, or arm span in a T pose).
+        The figure's largest extent (height, or arm span in a T pose), carrier roots left
+        out.
 
     Returns
     -------
@@ -95,14 +85,23 @@ def guess_unit(size):
 
     Notes
     -----
-    The choice minimises ``|log(size * unit / 1.7 m)|`` over :data:`UNITS`: a figure 150-190
-    units tall reads as centimetres, 1.5-1.9 as metres, 1500-1900 as millimetres, 55-75 as
-    inches, 27-34 as CMU units. A figure that is not human-sized may be misread: pass a scale.
+    The unit that makes the figure 1.2-2.2 m (:data:`HUMAN_SIZE`) when there is one (the
+    range is narrower than the ratio of any two units in :data:`UNITS`, so there is at most
+    one): a figure 120-220 units across reads as centimetres, 1.2-2.2 as metres, 1200-2200
+    as millimetres, 47-87 as inches, 21-39 as CMU units. Otherwise the unit whose figure is
+    nearest 1.7 m, which :func:`believable` then reports as not a human's size.
     """
     if not size > 0:
         return "metres", 1.0
-    name = min(UNITS, key=lambda u: abs(np.log(size * UNITS[u] / TYPICAL_HEIGHT)))
+    human = [u for u in UNITS if believable(size * UNITS[u])]
+    name = human[0] if len(human) == 1 else \
+        min(UNITS, key=lambda u: abs(np.log(size * UNITS[u] / TYPICAL_HEIGHT)))
     return name, UNITS[name]
+
+
+def believable(metres):
+    """Whether a figure ``metres`` across is a human's size (:data:`HUMAN_SIZE`)."""
+    return HUMAN_SIZE[0] <= metres <= HUMAN_SIZE[1]
 
 
 def _axis_quats(axis, sin_half, cos_half):
@@ -171,22 +170,38 @@ def _channel_values(data):
     return rotations, translations
 
 
-def _figure_size(data, rotations, translations):
-    """Largest extent of the figure (joints and End Sites, file units) at frame 0, or at
-    rest when the file has no frames: a standing figure's height (or arm span)."""
-    offsets, ends = data["offsets"], data["ends"]
+def _sampled_poses(data, rotations, translations):
+    """Model-space joints (P, J, 3) and End Site points (P, T, 3), file units, at up to
+    :data:`SAMPLED_FRAMES` frames spread over the clip (frame 0 first), or at rest when the
+    file has no frames; and the End Sites' joints (T,)."""
+    offsets, ends, frames = data["offsets"], data["ends"], data["frames"]
     sk = Skeleton(data["names"], data["parents"], offsets)
-    pose_t, pose_r = offsets.copy(), sk.rest_rotation.copy()
-    if len(data["frames"]):
-        for j, q in rotations.items():
-            pose_r[j] = q[0]
-        for j, t in translations.items():
-            pose_t[j] = t[0]
-    model = sk.forward(compose_trs(pose_t, pose_r))
-    points = [model[:, :3, 3]] + [model[j, :3, :3] @ e + model[j, :3, 3]
-                                  for j, e in enumerate(ends) if e is not None]
-    points = np.vstack(points)
-    return float(np.max(points.max(axis=0) - points.min(axis=0)))
+    picks = np.unique(np.linspace(0, len(frames) - 1, SAMPLED_FRAMES).round().astype(int)) \
+        if len(frames) else [None]
+    owners = [j for j, e in enumerate(ends) if e is not None]
+    local_ends = np.array([ends[j] for j in owners]).reshape(-1, 3)
+    heads, tips = [], []
+    for f in picks:
+        pose_t, pose_r = offsets.copy(), sk.rest_rotation.copy()
+        if f is not None:
+            for j, q in rotations.items():
+                pose_r[j] = q[f]
+            for j, t in translations.items():
+                pose_t[j] = t[f]
+        model = sk.forward(compose_trs(pose_t, pose_r))
+        heads.append(model[:, :3, 3])
+        tips.append(np.einsum("tij,tj->ti", model[owners, :3, :3], local_ends)
+                    + model[owners, :3, 3])
+    return np.array(heads), np.array(tips).reshape(len(heads), -1, 3), np.array(owners, int)
+
+
+def _figure_size(heads, tips, owners, carriers):
+    """The figure's largest extent (file units): its joints and End Sites, carrier roots
+    left out, in each sampled pose; the 90th percentile over the poses, so that a crouch at
+    frame 0 or a run's lean does not shrink it and one glitched frame does not grow it."""
+    keep = np.flatnonzero(~carriers)
+    points = np.concatenate([heads[:, keep], tips[:, ~carriers[owners]]], axis=1)
+    return float(np.percentile(np.max(np.ptp(points, axis=1), axis=1), 90))
 
 
 def load_bvh(path, scale=None):
@@ -209,25 +224,35 @@ def load_bvh(path, scale=None):
     data = parse_bvh(path)
     offsets, parents, ends = data["offsets"], data["parents"], data["ends"]
     rotations, translations = _channel_values(data)
+    names = data["names"]
+    heads, tips, owners = _sampled_poses(data, rotations, translations)
+    carriers = carrier_joints(parents, heads)
+    size = _figure_size(heads, tips, owners, carriers)
+    left_out = ", ".join(names[j] for j in np.flatnonzero(carriers))
+    measured = f"{size:.4g} units across" + (f", carrier root {left_out} left out"
+                                             if left_out else "")
     if scale is None:
-        size = _figure_size(data, rotations, translations)
         unit, scale = guess_unit(size)
-        units_note = (f"guessed {unit} from the figure's size ({size:.4g} units at frame 0), "
-                      f"scale {scale:g} m per unit; pass --scale/scale= to override")
-        warnings.warn(f"{path}: BVH has no units; {units_note}", BvhUnitsWarning, stacklevel=2)
+        units_note = (f"guessed {unit} from the figure's size ({measured}): "
+                      f"{size * scale:.3g} m, scale {scale:g} m per unit")
+        if not believable(size * scale):
+            units_note += (f"; NOT SURE: no unit makes it a human's {HUMAN_SIZE[0]:g}-"
+                           f"{HUMAN_SIZE[1]:g} m (not a human, or an unusual unit)")
+        warnings.warn(f"{path}: BVH has no units; {units_note}; pass --scale/scale= to "
+                      f"override", BvhUnitsWarning, stacklevel=2)
     else:
         scale = float(scale)
         if not np.isfinite(scale) or scale <= 0:
             raise RigFileError(path, f"expected a scale > 0 (metres per unit), got {scale}")
-        units_note = f"scale {scale:g} m per unit (given)"
-    heads, tips = _rest_points(parents, offsets, ends)
-    tails = np.full_like(heads, np.nan)
+        units_note = f"scale {scale:g} m per unit (given): {size * scale:.3g} m across"
+    rest = Skeleton(names, parents, offsets).bind_matrices[:, :3, 3]
+    tails = np.full_like(rest, np.nan)
     for j, end in enumerate(ends):
         if end is not None and np.any(end != 0):
-            tails[j] = (heads[j] + end) * scale
-    names = data["names"]
-    skeleton = Skeleton(names, parents, offsets * scale, tails=tails,
-                        deform=_deforming(parents, heads, tips))
+            tails[j] = (rest[j] + end) * scale
+    # a carrier root deforms nothing: its "bone" runs from the floor (or the origin) to
+    # the hips
+    skeleton = Skeleton(names, parents, offsets * scale, tails=tails, deform=~carriers)
     clips = {}
     if len(data["frames"]):
         times = np.arange(len(data["frames"])) * data["frame_time"]
@@ -243,6 +268,8 @@ def load_bvh(path, scale=None):
               up="y", path=path)
     rig.notes = {"units": units_note,
                  "frames": "BVH read as Y up, +Z forward (its usual convention), axes kept"}
+    if carriers.any():
+        rig.notes["carrier"] = carrier_note(names, parents, heads, carriers, scale)
     # each joint's rotation channel order, so that a BVH written back keeps it (bvh_write)
     orders = {name: "".join("XYZ"[axis] for kind, axis in channels if kind == "rotation")
               for name, channels in zip(names, data["channels"])}

@@ -13,8 +13,10 @@ rotation and translation that reproduce each joint's model-space position and or
 OFFSETs come from the rest pose the same way; a joint gets position channels when it is a
 root or when its local translation moves away from its offset during the clip. Reading the
 file back gives the same joint positions per frame. Lengths are written in centimetres by
-default (the most common BVH unit, which rigedit's unit guess reads back as such for a
-human-sized figure).
+default (the most common BVH unit, and what most tools expect): rigedit's unit guess reads a
+figure of a human's size (1.2-2.2 m, carrier roots left out) back as centimetres, so a round
+trip keeps its size; for any other figure the writer warns (:class:`BvhUnitsWarning`) that
+it must be read back with ``scale=0.01``.
 """
 from __future__ import annotations
 
@@ -25,6 +27,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..errors import RigFileError
+from ..model.carrier import carrier_joints
 from .atomic import atomic_write
 
 __all__ = ["save_bvh", "bvh_frame_times", "DEFAULT_FPS"]
@@ -112,6 +115,21 @@ def _bvh_names(names):
     return out
 
 
+def _warn_unless_human(positions, parents, units_per_metre, path):
+    """Warn when the figure in ``positions`` (F, J, 3) metres, carrier roots left out, is
+    not a human's size: reading the file back will not guess its unit (BVH has none)."""
+    from .bvh import HUMAN_SIZE, BvhUnitsWarning, believable
+
+    picks = positions[np.unique(np.linspace(0, len(positions) - 1, 32).round().astype(int))]
+    carriers = carrier_joints(parents, picks)
+    size = float(np.percentile(np.ptp(picks[:, ~carriers], axis=1).max(axis=1), 90))
+    if not believable(size):
+        warnings.warn(f"{path}: the figure is {size:.3g} m across, not a human's "
+                      f"{HUMAN_SIZE[0]:g}-{HUMAN_SIZE[1]:g} m: read it back with scale="
+                      f"{1 / units_per_metre:g} (BVH has no units; a guess may differ)",
+                      BvhUnitsWarning, stacklevel=3)
+
+
 def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order=None):
     """Write ``rig``'s skeleton and one clip as a BVH file, atomically.
 
@@ -149,7 +167,9 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order=None):
         if sorted(o) != ["X", "Y", "Z"]:
             raise ValueError(f"expected a rotation order of X, Y and Z, got {o!r}")
     times, dt = bvh_frame_times(clip, fps)
-    local_rot, local_t, _, _ = _local_parts(_model_frames(rig, clip, times), sk.parents)
+    local_rot, local_t, _, frame_pos = _local_parts(_model_frames(rig, clip, times),
+                                                    sk.parents)
+    _warn_unless_human(frame_pos, sk.parents, float(units_per_metre), path)
     rest_model = rig.joint_matrices(rig.rest_pose())
     _, offsets, rest_rot, rest_pos = _local_parts(rest_model, sk.parents)
     size = float(np.ptp(np.vstack([rest_pos, local_t[:, 0]]), axis=0).max()) or 1.0

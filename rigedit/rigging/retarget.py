@@ -18,7 +18,10 @@ body forward and left as close as they go), the target joint's model rotation is
 bone direction exact in that frame (it differs from identity where unmapped source joints
 between two mapped ones bend). When both rests stand alike, ``X`` is the identity and this is
 ``S(t) · S_c⁻¹ · T_c``. The source is first turned about the vertical axis by the multiple of
-90 degrees that brings its facing (heel to toe; hind feet to fore feet) onto the target's.
+90 degrees that brings its facing onto the target's (:mod:`.facing`): the rest's (heel to toe;
+hind feet to fore feet) where the rest stands, else its hips' over all frames of the clip; a
+calibration pose that is not the rest faces where its pelvis does (mid-stride the feet do
+not), so the target's hips face as the source's do relative to their path.
 
 The hips follow the source's hips scaled by the ratio of hip heights (target / source, each
 the height of the thigh joints standing straight: the leg length; for a quadruped its hind
@@ -37,6 +40,7 @@ from ..animation.clip import Clip
 from .bake import assemble, to_clip
 from .calibrate import calibrate, model_stack
 from .contacts import clean_feet as hold_feet, clean_legs, detect_contacts
+from .facing import clip_forward, face_by_hips, heading_degrees
 from .limbs import LegCalibration, ground, leg_contacts
 from .name_map import auto_map
 from .pitch import pitch_body
@@ -104,10 +108,12 @@ def _sample_times(clip):
     return times
 
 
-def _facing(src, tgt):
-    """Turn about +Y (multiple of 90 degrees) taking the source's forward to the target's."""
-    a = np.arctan2(tgt.forward[0], tgt.forward[2]) - np.arctan2(src.forward[0], src.forward[2])
-    deg = float(np.round(np.degrees(a) / 90.0) * 90.0) % 360.0
+def _facing(src, tgt, smats):
+    """Turn about +Y (multiple of 90 degrees) taking the source clip's forward (its rest's,
+    else its hips' over all frames ``smats``: :func:`.facing.clip_forward`) to the
+    target's."""
+    a = heading_degrees(tgt.forward) - heading_degrees(clip_forward(src, smats))
+    deg = float(np.round(a / 90.0) * 90.0) % 360.0
     return deg, Rotation.from_euler("y", deg, degrees=True).as_matrix()
 
 
@@ -157,11 +163,15 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
         map = auto_map(ssk, src.points, tsk, tgt.points, source_what, target_what) \
             if humanoid else leg_map(src, tgt)
     inverse = _inverse_map(map, src, tgt, source_what, target_what)
-    facing, rf = _facing(src, tgt)
     times = _sample_times(source_clip)
+    smats = model_stack(ssk, source_clip, times)
+    # a pose that is not the rest (mid-stride) faces where its pelvis does, not its feet
+    face_by_hips(src)
+    face_by_hips(tgt)
+    facing, rf = _facing(src, tgt, smats)
     turn = np.eye(4)
     turn[:3, :3] = rf
-    smats = turn @ model_stack(ssk, source_clip, times)
+    smats = turn @ smats
     scal = turn @ src.mats
     s_feet = smats[:, src.contacts][..., :3, 3]
     # the motion's own floor: a low percentile of the lowest foot point per frame
