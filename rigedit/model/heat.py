@@ -33,7 +33,7 @@ import scipy.sparse as sp
 
 from . import laplacian as lap
 from .skinning import top_k_influences
-from .tails import deforming_joints, infer_leaf_tails
+from .tails import branch_tails, deforming_joints, infer_leaf_tails
 from .visibility import SurfaceRays
 from .weights import inverse_distance_weights, point_segment_distance
 
@@ -44,10 +44,15 @@ except ImportError:  # pragma: no cover - machines without scikit-sparse
 
 __all__ = ["heat_weights", "WeightsResult", "HeatWeightsWarning"]
 
-C_HEAT = 1.0            # c in H = c / d^2 (Baran and Popovic; Blender)
+# c in H = c / d^2. Baran and Popovic's 1 is half of Blender's in effect (its Laplacian is
+# half the Laplace-Beltrami operator: 0.5 / area times the cotangent sum over 2), and artists
+# blend neighbouring bones more tightly still: the error against the artists' weights of
+# the shared characters is least for c between 3 and 4, flat around it (README).
+C_HEAT = 4.0
 TIE = 1e-4              # bones within this relative distance of the nearest share the vertex
 MAX_ROUNDS = 8          # how many nearest bones to try before a vertex sees none
 BEHIND = -0.1           # see ``behind`` in heat_weights
+RING_BEHIND = 0.75      # see _visible
 MIN_WEIGHT = 0.01       # influences below this (after top-K) are dropped
 WELD = 1e-6             # weld distance, as a fraction of the bounding-box diagonal
 CHUNK = 16384           # vertices per block of the distance computation
@@ -173,7 +178,7 @@ def _factor_solve(A, B, solver="auto"):
 def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None,
                  c=C_HEAT, min_weight=MIN_WEIGHT, front_only=False, normal_bias=False,
                  behind=BEHIND, infer_tails=True, operator="cotan", solver="auto",
-                 use_numba=None):
+                 use_numba=None, branches="children", helpers=True):
     """Bone-heat weights of a triangle mesh (see the module notes).
 
     Parameters
@@ -210,6 +215,14 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
         CHOLMOD (scikit-sparse) when installed, else SciPy's SuperLU.
     use_numba : bool, optional
         Force the compiled or the numpy ray tests (default: compiled when available).
+    branches : {"children", "centroid"}
+        A tail-less joint with several children owns a segment to each child (default), or
+        one bone toward their centroid (:func:`.tails.branch_tails`, Blender's importer's
+        rule; measured better on the Mixamo character only, see the README).
+    helpers : bool
+        Leave out helper joints (:mod:`.helper_joints`: end markers, IK and pole targets,
+        twist and share bones, carrier roots confirmed by the mesh); see
+        :func:`.tails.deforming_joints`.
 
     Returns
     -------
@@ -249,16 +262,22 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
     t0 = time.perf_counter()
     rays = SurfaceRays(wv, wf, use_numba=use_numba)
     normals = lap.vertex_normals(wv, wf, label)
-    deform = deforming_joints(skeleton, wv, normals)
+    deform = deforming_joints(skeleton, wv, normals, helpers=helpers)
     tails = skeleton.tails
-    starts, ends, owners = skeleton.bone_segments(deform=deform)
+    if branches == "centroid":
+        tails = branch_tails(skeleton, deform, tails)
+    elif branches != "children":
+        raise ValueError(f"expected branches 'children' or 'centroid', got {branches!r}")
+    starts, ends, owners = skeleton.bone_segments(deform=deform, tails=tails)
     joints = np.unique(owners)
     dist, seg = _joint_distances(wv, starts, ends, owners, joints)
     if infer_tails:
-        tails = infer_leaf_tails(skeleton, deform, wv, joints[dist.argmin(axis=1)], rays)
+        given = tails
+        tails = infer_leaf_tails(skeleton, deform, wv,
+                                 joints[dist.argmin(axis=1)], rays, tails=given)
         starts, ends, owners = skeleton.bone_segments(deform=deform, tails=tails)
         changed = np.isin(owners, np.flatnonzero(np.isfinite(tails[:, 0])
-                                                 & ~np.isfinite(skeleton.tails[:, 0])))
+                                                 & ~np.isfinite(given[:, 0])))
         if changed.any():  # only the leaves that got a tail
             base = np.flatnonzero(changed)
             _joint_distances(wv, starts[base], ends[base], owners[base], joints, dist, seg,
@@ -272,9 +291,11 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
     if normal_bias:
         rank = _normal_biased(wv, normals, starts, ends, seg, dist)
 
+    ring = lap.OneRing(wv, wf, label)
+
     def test(verts, cols):
-        return _visible(wv, normals, verts, cols, seg, starts, ends, rays, front_only, behind,
-                        1e-4 * diag)
+        return _visible(wv, normals, ring, verts, cols, seg, starts, ends, rays, front_only,
+                        behind, 1e-4 * diag)
     pairs_v, pairs_j, best = _visible_nearest(wv, rank, dist, seg, starts, ends, report, test)
     timings["visibility"] = time.perf_counter() - t0
 
@@ -390,23 +411,38 @@ def _visible_nearest(wv, rank, dist, seg, starts, ends, report, test):
     return np.concatenate(pv), np.concatenate(pj), best
 
 
-def _visible(wv, normals, verts, joints, seg, starts, ends, rays, front_only, behind, offset):
+def _visible(wv, normals, ring, verts, joints, seg, starts, ends, rays, front_only, behind,
+             offset):
     """(N,) bool: joint ``joints[n]`` is visible from vertex ``verts[n]``: the segment to
-    its nearest point crosses no triangle, and that point lies behind the vertex's surface
-    (``cos(normal, to bone) < behind``; a bone in front of the skin is outside the body)."""
+    its nearest point crosses no triangle, and that point lies behind the vertex's surface:
+    ``cos(normal, to bone) < behind``, and behind (or in) the planes of the vertex's own
+    triangles that hold ``RING_BEHIND`` of their area (a bone in front of the skin is
+    outside the body; at a sharp rim the averaged normal alone cannot tell)."""
     s = seg[verts, joints]
     target = _nearest_on_segment(wv[verts], starts[s], ends[s])
     to_bone = target - wv[verts]
     cos = np.einsum("ij,ij->i", to_bone, normals[verts]) / np.maximum(
         np.linalg.norm(to_bone, axis=1), 1e-300)
     ok = cos < behind
-    # Start a hair inside the surface and test the vertex's own triangles too: a segment
-    # from a sharp rim that heads out through the rim's other face is then caught, and one
-    # that would run in the plane of a flat face cannot slip along its edges. The last bit
-    # of the segment stays free: a bone lying on the skin is still seen.
-    start = wv[verts[ok]] - offset * normals[verts[ok]]
-    ok[ok] = ~rays.blocked(start, target[ok], t_lo=0.0, t_hi=1.0 - 1e-4,
-                           front_only=front_only)
+    if behind < 1.0:  # behind >= 1 turns the side tests off
+        ok[ok] = ring.behind_share(verts[ok], to_bone[ok]) >= RING_BEHIND
+    # A vertex on the bone (a cap's centre on a root) has no direction to it: it sees it.
+    on = np.einsum("ij,ij->i", to_bone, to_bone) <= offset * offset
+    ok[on] = True
+    # Start a hair inside, between the way to the bone and against the normal, and test
+    # the vertex's own triangles too. Against the normal alone, a start at a sharp rim
+    # can fall outside the rim's other face when the averaged normal is far from that
+    # face's (a cylinder's end ring, mostly side faces: every segment to the bone then
+    # crossed the end cap); along the segment alone, a segment leaving tangentially along
+    # a wall starts outside and is never blocked. The last bit of the segment stays free:
+    # a bone lying on the skin is still seen.
+    unit = to_bone[ok] / np.maximum(np.linalg.norm(to_bone[ok], axis=1), 1e-300)[:, None]
+    step = unit - normals[verts[ok]]
+    step /= np.maximum(np.linalg.norm(step, axis=1), 1e-300)[:, None]
+    start = wv[verts[ok]] + offset * step
+    test = ok & ~on
+    ok[test] = ~rays.blocked(start[~on[ok]], target[test], t_lo=0.0, t_hi=1.0 - 1e-4,
+                             front_only=front_only)
     return ok
 
 

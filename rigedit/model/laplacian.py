@@ -16,7 +16,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 __all__ = ["weld", "clean_faces", "cotangent_laplacian", "components", "vertex_normals",
-           "face_areas", "COT_MAX"]
+           "oriented_face_normals", "OneRing", "face_areas", "COT_MAX"]
 
 # cot(1 degree) ~ 57: angles below one degree are treated as one degree.
 COT_MAX = 1.0 / np.tan(np.radians(1.0))
@@ -147,8 +147,8 @@ def components(n, faces):
     return connected_components(g, directed=False)
 
 
-def vertex_normals(vertices, faces, labels=None):
-    """Unit area-weighted vertex normals, turned outward part by part.
+def oriented_face_normals(vertices, faces, labels=None):
+    """(F, 3) face normals of length twice the face's area, turned outward part by part.
 
     Parameters
     ----------
@@ -157,11 +157,6 @@ def vertex_normals(vertices, faces, labels=None):
     labels : (V,) int, optional
         Connected part of each vertex (:func:`components`); computed when omitted. A part
         whose signed volume is negative (faces wound inward) has its normals flipped.
-
-    Returns
-    -------
-    normals : (V, 3) float64
-        Zero for a vertex in no triangle.
     """
     if labels is None:
         labels = components(len(vertices), faces)[1]
@@ -178,6 +173,53 @@ def vertex_normals(vertices, faces, labels=None):
     volume = np.bincount(part, weights=np.einsum("ij,ij->i", fn, tri[:, 0] - centre[part]),
                          minlength=parts)
     fn *= np.where(volume[part] < 0, -1.0, 1.0)[:, None]
+    return fn
+
+
+class OneRing:
+    """Each vertex's triangles, to ask which way is into the body at a vertex.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float64
+    faces : (F, 3) int64
+    labels : (V,) int, optional
+        As for :func:`oriented_face_normals`.
+    """
+
+    def __init__(self, vertices, faces, labels=None):
+        fn = oriented_face_normals(vertices, faces, labels)
+        area = np.linalg.norm(fn, axis=1)
+        self.unit = fn / np.maximum(area, 1e-300)[:, None]
+        n, f = len(vertices), len(faces)
+        self.inc = sp.csr_matrix((np.repeat(area, 3), (faces.ravel(),
+                                                        np.repeat(np.arange(f), 3))),
+                                 shape=(n, f))
+        self.total = np.maximum(np.asarray(self.inc.sum(axis=1)).ravel(), 1e-300)
+
+    def behind_share(self, verts, dirs, grazing=0.02):
+        """(N,) float: the share of the one-ring area of ``verts[n]`` whose face plane has
+        ``dirs[n]`` (N, 3) behind it (pointing into the body) or in it (cosine with the
+        face normal below ``grazing``: from a rim, a bone at a cap's centre lies in the
+        cap's plane)."""
+        rows = self.inc[verts]
+        r = np.repeat(np.arange(len(verts)), np.diff(rows.indptr))
+        unit = dirs / np.maximum(np.linalg.norm(dirs, axis=1), 1e-300)[:, None]
+        behind = np.einsum("ij,ij->i", self.unit[rows.indices], unit[r]) < grazing
+        return np.bincount(r, weights=rows.data * behind, minlength=len(verts)) \
+            / self.total[verts]
+
+
+def vertex_normals(vertices, faces, labels=None):
+    """Unit area-weighted vertex normals, turned outward part by part
+    (:func:`oriented_face_normals`, whose parameters these are).
+
+    Returns
+    -------
+    normals : (V, 3) float64
+        Zero for a vertex in no triangle.
+    """
+    fn = oriented_face_normals(vertices, faces, labels)
     normals = np.zeros_like(vertices)
     for k in range(3):
         np.add.at(normals, faces[:, k], fn)

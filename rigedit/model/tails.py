@@ -24,14 +24,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from .helper_joints import CARRIER, carrier_candidates, helper_joints
 
-__all__ = ["deforming_joints", "infer_leaf_tails"]
+__all__ = ["deforming_joints", "infer_leaf_tails", "branch_tails"]
 
 REACH = 0.8
 MIN_REGION = 3
 
 
-def deforming_joints(skeleton, vertices, normals):
+def deforming_joints(skeleton, vertices, normals, helpers=True):
     """(J,) bool: joints that may take weight.
 
     Parameters
@@ -41,6 +42,11 @@ def deforming_joints(skeleton, vertices, normals):
     normals : (V, 3) float64
         Outward vertex normals (:func:`rigedit.model.laplacian.vertex_normals`); the mesh is
         the scale of "zero length" and the carrier test's judge of inside.
+    helpers : bool
+        Leave out the helper joints :func:`rigedit.model.helper_joints.helper_joints` finds
+        (end markers, IK and pole targets, twist and share bones), and test its carrier
+        candidates against the mesh; otherwise only a root at the origin with one child is
+        tested as a carrier.
     """
     heads = skeleton.bind_matrices[:, :3, 3]
     lo, hi = vertices.min(axis=0), vertices.max(axis=0)
@@ -58,12 +64,23 @@ def deforming_joints(skeleton, vertices, normals):
             continue  # a leaf: gets an inferred tail
         if np.all(np.linalg.norm(ends - heads[j], axis=1) < tiny):
             deform[j] = False
-    for j in np.flatnonzero(deform & (skeleton.parents < 0)):
+    if helpers:
+        reasons = helper_joints(skeleton.names, skeleton.parents, heads)
+        deform &= (reasons == "") | (reasons == CARRIER)
+        roots = carrier_candidates(skeleton.names, skeleton.parents, heads)
+    else:
+        roots = [j for j in np.flatnonzero(skeleton.parents < 0)
+                 if np.linalg.norm(heads[j]) < tiny and len(skeleton.children(j)) == 1]
+    for j in roots:
         kids = skeleton.children(j)
-        if np.linalg.norm(heads[j]) < tiny and len(kids) == 1:
-            along = heads[j] + np.linspace(0.05, 0.95, 10)[:, None] * (heads[kids[0]] - heads[j])
-            if _inside_fraction(along, vertices, normals) < 0.5:
-                deform[j] = False
+        if not deform[j] or not len(kids):
+            continue
+        # A carrier's bones (to each child) lie mostly outside the body: a root on the
+        # ground between the feet, not a hip root inside the pelvis.
+        t = np.linspace(0.05, 0.95, 10)[None, :, None]
+        along = (heads[j] + t * (heads[kids] - heads[j])[:, None, :]).reshape(-1, 3)
+        if _inside_fraction(along, vertices, normals) < 0.5:
+            deform[j] = False
     if not skeleton.deform.any():
         raise ValueError("expected at least one deforming joint, got none")
     if not deform.any():  # the rules above removed every joint: keep the flagged ones
@@ -79,7 +96,7 @@ def _inside_fraction(points, vertices, normals):
     return float(np.mean(np.einsum("ij,ij->i", points - vertices[near], normals[near]) < 0))
 
 
-def infer_leaf_tails(skeleton, deform, vertices, nearest_owner, rays=None):
+def infer_leaf_tails(skeleton, deform, vertices, nearest_owner, rays=None, tails=None):
     """Tails for deforming leaf joints that have none (see the module notes).
 
     Parameters
@@ -98,7 +115,7 @@ def infer_leaf_tails(skeleton, deform, vertices, nearest_owner, rays=None):
         The skeleton's tails with inferred ones filled in (NaN elsewhere).
     """
     heads = skeleton.bind_matrices[:, :3, 3]
-    tails = skeleton.tails.copy()
+    tails = (skeleton.tails if tails is None else tails).copy()
     todo = [j for j in np.flatnonzero(deform)
             if not np.all(np.isfinite(tails[j])) and len(skeleton.children(j)) == 0]
     if not todo:
@@ -131,4 +148,37 @@ def infer_leaf_tails(skeleton, deform, vertices, nearest_owner, rays=None):
     for n, j in enumerate(todo):
         if lengths[n] > 0:
             tails[j] = heads[j] + dirs[n] * lengths[n]
+    return tails
+
+
+def branch_tails(skeleton, deform, tails):
+    """One tail for each deforming joint with several children and no tail of its own:
+    toward the centroid of the children, as long as the nearest child is far (Blender's
+    glTF importer's bone, without its snap to the local axes); otherwise such a joint owns
+    a segment to each child.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+    deform : (J,) bool
+    tails : (J, 3) float64
+        NaN rows where a joint has no tail.
+
+    Returns
+    -------
+    tails : (J, 3) float64
+        A copy with those tails filled in.
+    """
+    heads = skeleton.bind_matrices[:, :3, 3]
+    tails = tails.copy()
+    for j in np.flatnonzero(deform):
+        kids = skeleton.children(j)
+        if len(kids) < 2 or np.all(np.isfinite(tails[j])):
+            continue
+        off = heads[kids] - heads[j]
+        length = np.linalg.norm(off, axis=1)
+        off, length = off[length > 1e-12], length[length > 1e-12]
+        centre = off.mean(axis=0) if len(off) else np.zeros(3)
+        if len(off) >= 2 and np.linalg.norm(centre) > 1e-12:
+            tails[j] = heads[j] + centre / np.linalg.norm(centre) * length.min()
     return tails

@@ -1,0 +1,93 @@
+"""Heat weights on the rigs artists make: helper joints take no weight, end rings see bones.
+
+Each case is a failure the shared characters showed (see the README's "Automatic weights"):
+a carrier root with several children on the ground (the horse), end markers (Mixamo's
+``*_End`` and fourth finger joints), pole targets (RobotExpressive), and a coarse cylinder
+whose end rings saw no bone (RiggedSimple).
+"""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from builders import cylinder
+from rigedit.model import Skeleton
+from rigedit.model.heat import HeatWeightsWarning, heat_weights
+from rigedit.model.skinning import dense_weights
+
+
+def heat(v, sk, f, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", HeatWeightsWarning)
+        idx, w = heat_weights(v, sk, f, **kw)
+    return dense_weights(idx, w, len(sk))
+
+
+def skeleton(names, parents, heads, tails=None):
+    heads = np.asarray(heads, float)
+    parents = np.asarray(parents)
+    t = heads - np.where(parents[:, None] >= 0, heads[np.maximum(parents, 0)], 0.0)
+    if tails is None:
+        tails = np.full_like(heads, np.nan)
+    return Skeleton(names, parents, t, tails=np.asarray(tails, float))
+
+
+def leg(height=3.0):
+    """A cylinder standing on y = 0.2 (a leg or a body above the ground)."""
+    v, f = cylinder(radius=0.3, height=height, rings=31)
+    return v + [0, 0.2, 0], f
+
+
+def test_a_carrier_root_on_the_ground_with_several_children_takes_no_weight():
+    v, f = leg()
+    nan = [np.nan] * 3
+    sk = skeleton(["root", "Body", "Spine", "Chest", "Foot.L", "Foot.R"],
+                  [-1, 0, 1, 2, 0, 0],
+                  [[0, 0, 0], [0, 0.3, 0], [0, 1.3, 0], [0, 2.3, 0], [0.8, 0, 0],
+                   [-0.8, 0, 0]],
+                  [nan, nan, nan, [0, 3.1, 0], nan, nan])
+    w = heat(v, sk, f)
+    assert w[:, 0].max() == 0.0                       # the carrier
+    low = v[:, 1] < 0.5
+    assert w[low, 1].min() > 0.9                      # the body's bottom is the body's
+    before = heat(v, sk, f, helpers=False)            # the old rule: one child only
+    assert before[:, 0].max() > 0.5
+
+
+def test_end_markers_and_pole_targets_take_no_weight():
+    v, f = leg()
+    nan = [np.nan] * 3
+    sk = skeleton(["Hips", "Spine", "Head", "HeadTop_End", "PoleTarget.L"],
+                  [-1, 0, 1, 2, 0],
+                  [[0, 0.3, 0], [0, 1.3, 0], [0, 2.3, 0], [0, 3.2, 0], [0.1, 1.0, 0.1]])
+    w = heat(v, sk, f)
+    assert w[:, 3].max() == 0.0 and w[:, 4].max() == 0.0
+    top = v[:, 1] > 2.8
+    assert w[top, 2].min() > 0.95                     # the head's bone reaches the marker
+    before = heat(v, sk, f, helpers=False)
+    assert before[top, 3].max() > 0.5 and before[:, 4].max() > 0.5
+
+
+def test_the_end_rings_of_a_coarse_tapered_cylinder_see_their_bone():
+    # RiggedSimple's shape: three rings along a long tapered tube (radius 1 to 0.5), so
+    # the averaged normal at an end ring points a little back along the axis (the side
+    # faces outweigh the cap's). A start pushed in along that normal fell outside the cap
+    # and every segment to the bone crossed it: the end rings took heat from the far bone.
+    ang = np.linspace(0, 2 * np.pi, 32, endpoint=False)
+    rings = [(-4.58, 1.0), (0.0, 0.5), (4.58, 0.45)]
+    v = np.concatenate([np.stack([r * np.cos(ang), r * np.sin(ang), np.full(32, z)], 1)
+                        for z, r in rings])
+    f = []
+    for k in range(2):
+        for s in range(32):
+            a, b = 32 * k + s, 32 * k + (s + 1) % 32
+            f += [(a, b, b + 32), (a, b + 32, a + 32)]
+    for s in range(1, 31):  # each cap a fan from one rim vertex: slivers, little area
+        f += [(0, s + 1, s), (64, 64 + s, 64 + s + 1)]
+    f = np.array(f)
+    sk = skeleton(["Bone", "Bone.001"], [-1, 0], [[0, 0, -4.18], [0, 0, 0.0]],
+                  [[np.nan] * 3, [0, 0, 4.18]])
+    w = heat(v, sk, f)
+    bottom, top = v[:, 2] < -4, v[:, 2] > 4
+    assert w[bottom, 0].min() > 0.98 and w[top, 1].min() > 0.98
