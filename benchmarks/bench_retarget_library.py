@@ -29,8 +29,9 @@ from pathlib import Path
 import numpy as np
 
 import rigedit
+from bench_retarget import _table  # noqa: E402  (the benchmarks folder is on sys.path)
 from rigedit.rigging import retarget_result
-from rigedit.rigging.transfer import end_points
+from rigedit.rigging.measure import direction_errors
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"
@@ -42,7 +43,8 @@ TARGETS = {"humanoid": "humanoid", "CesiumMan": CESIUM, "Xbot": XBOT}
 
 def sources():
     """(label, path) of every shared motion file, in library order."""
-    out = [(f"Bandai {p.stem.split('_')[1]}", p) for p in sorted((DATA / "bvh-bandai").glob("*.bvh"))]
+    out = [(f"Bandai {p.stem.split('_')[1]}", p)
+           for p in sorted((DATA / "bvh-bandai").glob("*.bvh"))]
     out += [(f"Bandai-2 {p.stem.split('_')[1]}", p)
             for p in sorted((DATA / "bvh-library" / "bandai-2").glob("*.bvh"))]
     out += [("CMU 131_01", DATA / "bvh-cmu" / "131_01.bvh")]
@@ -58,28 +60,21 @@ def _load(path):
         return rigedit.load_rig(path)
 
 
-def bone_errors(res, mats):
-    """Mean angle (degrees) per measured bone pair over the frames, and whether it is a foot
-    bone: ``[(angle, is_foot, worst)]``."""
+def _means(res, mats):
+    """Mean angle over every measured bone, over those outside the feet (each bone's mean
+    over the frames, :func:`direction_errors` per group weighted by its bones), and the
+    worst single frame outside the feet."""
+    err = direction_errors(res, mats)
     tgt = res.target_calibration
-    out = []
-    for j, t_spec, s, s_spec in res.pairs:
-        g = tgt.group(j)
-        if g is None:
-            continue
-        vt = end_points(mats, t_spec) - mats[:, j, :3, 3]
-        vs = end_points(res.source_mats, s_spec) - res.source_mats[:, s, :3, 3]
-        cos = np.sum(vt * vs, axis=1) / (np.linalg.norm(vt, axis=1) * np.linalg.norm(vs, axis=1))
-        ang = np.degrees(np.arccos(np.clip(cos, -1, 1)))
-        out.append((float(ang.mean()), g == "feet", float(ang.max())))
-    return out
+    count = {g: 0 for g in tgt.groups}
+    for j, *_ in res.pairs:
+        if tgt.group(j) is not None:
+            count[tgt.group(j)] += 1
 
-
-def _means(errs):
-    every = np.mean([e for e, _, _ in errs])
-    body = [e for e, foot, _ in errs if not foot]
-    worst = max((w for _, foot, w in errs if not foot), default=float("nan"))
-    return float(every), float(np.mean(body)) if body else float("nan"), worst
+    def mean(groups):
+        n = sum(count[g] for g in groups)
+        return sum(count[g] * err[g] for g in groups if count[g]) / n if n else float("nan")
+    return mean(tgt.groups), mean([g for g in tgt.groups if g != "feet"]), err["worst"]
 
 
 def run():
@@ -98,25 +93,13 @@ def run():
                     rows.append([label, clip, tname, "-", "error: " + str(exc)[:60]] + [""] * 5)
                     continue
                 dt = time.perf_counter() - t0
-                b_all, b_body, _ = _means(bone_errors(res, res.raw_mats))
-                a_all, a_body, worst = _means(bone_errors(res, res.mats))
+                b_all, b_body, _ = _means(res, res.raw_mats)
+                a_all, a_body, worst = _means(res, res.mats)
                 numbers.append((label, tname, a_all, a_body, dt, len(res.mapping)))
                 rows.append([label, clip, tname, str(len(res.mapping)), f"{b_all:.2f}",
                              f"{a_all:.2f}", f"{b_body:.2f}", f"{a_body:.2f}", f"{worst:.1f}",
                              f"{dt:.2f}"])
     return rows, numbers
-
-
-def _table(head, rows, markdown):
-    if markdown:
-        print("| " + " | ".join(head) + " |")
-        print("|" + "---|" * len(head))
-        for r in rows:
-            print("| " + " | ".join(r) + " |")
-    else:
-        widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(head)]
-        for r in [head] + rows:
-            print("  ".join(c.rjust(w) for c, w in zip(r, widths)))
 
 
 def main(argv):

@@ -441,8 +441,9 @@ def unmapped_parts(calibration, mapped):
     -------
     parts : list of str
         Humanoids (whatever calibrated the pair): ``"left arm"``, ``"right leg"``,
-        ``"spine"``, ``"head"``, each with the joints missing; other skeletons: each leg none of whose joints is mapped (by its
-        foot) and the spine (hips to chest). Empty when everything is reached.
+        ``"spine"``, ``"head"``, each with the joints missing; other skeletons: each leg
+        none of whose joints is mapped (by its foot) and the spine (hips to chest). Empty
+        when everything is reached.
     """
     mapped = set(mapped)
     sk = calibration.skeleton
