@@ -18,8 +18,8 @@ from scipy.spatial.transform import Rotation
 
 from .calibrate import foot_points, rotations_of, swing, tail_point, unit
 
-__all__ = ["detect_contacts", "runs", "pin_offsets", "two_bone_ik", "clean_feet", "clean_legs",
-           "HEIGHT_TOL", "SPEED_TOL"]
+__all__ = ["detect_contacts", "runs", "ramp", "pin_offsets", "two_bone_ik", "clean_feet",
+           "clean_legs", "solve_legs", "blend_frames", "smooth_max", "HEIGHT_TOL", "SPEED_TOL"]
 
 HEIGHT_TOL = 0.06
 SPEED_TOL = 0.5
@@ -30,6 +30,20 @@ def runs(mask):
     m = np.r_[False, np.asarray(mask, bool), False].astype(np.int8)
     edges = np.flatnonzero(np.diff(m))
     return list(zip(edges[::2].tolist(), edges[1::2].tolist()))
+
+
+def ramp(mask, blend):
+    """(F,) float64: 1 where the (F,) bool ``mask`` is True, falling to 0 over ``blend``
+    frames either side (``1 - d / (blend + 1)`` at ``d`` frames from the nearest True), the
+    weights :func:`pin_offsets` gives a contact's hold."""
+    mask = np.asarray(mask, bool)
+    if not mask.any():
+        return np.zeros(len(mask))
+    on = np.flatnonzero(mask)
+    f = np.arange(len(mask))
+    k = np.clip(np.searchsorted(on, f), 1, len(on) - 1) if len(on) > 1 else np.zeros_like(f)
+    d = np.minimum(np.abs(f - on[k]), np.abs(f - on[np.maximum(k - 1, 0)]))
+    return np.maximum(0.0, 1.0 - d / (blend + 1))
 
 
 def detect_contacts(points, rest_heights, times, leg_length, height_tol=HEIGHT_TOL,
@@ -160,7 +174,7 @@ def clean_feet(skeleton, tgt, rot, mats, contact, feet, times, mapped):
     rot = rot.copy()
     pts = mats[:, feet][..., :3, 3]
     rest_pts = tgt.mats[feet, :3, 3]
-    blend = _blend_frames(times)
+    blend = blend_frames(times)
     offsets, weights = pin_offsets(pts, contact, rest_pts[:, 1], blend)
     goals = {}
     for side, (ankle_i, toe_i) in (("L", (0, 2)), ("R", (1, 3))):
@@ -192,7 +206,7 @@ def clean_feet(skeleton, tgt, rot, mats, contact, feet, times, mapped):
         goals[side] = (ankle, goal)
     legs = [(tgt.slots[f"thigh_{side}"], tgt.slots[f"shin_{side}"], ankle, goal)
             for side, (ankle, goal) in goals.items()]
-    return _solve_legs(skeleton, tgt, rot, mats, legs, blend, mapped)
+    return solve_legs(skeleton, tgt, rot, mats, legs, blend, mapped)
 
 
 def clean_legs(skeleton, tgt, rot, mats, contact, legs, times, mapped, heights=None):
@@ -218,7 +232,7 @@ def clean_legs(skeleton, tgt, rot, mats, contact, legs, times, mapped, heights=N
     """
     rot = rot.copy()
     pts = mats[:, [leg.contact for leg in legs]][..., :3, 3]
-    blend = _blend_frames(times)
+    blend = blend_frames(times)
     # the floor, not each point's rest height: a hoof's fetlock sinks while its tip stands
     offsets, weights = pin_offsets(pts, contact, np.full(len(legs), tgt.floor), blend,
                                    heights)
@@ -230,15 +244,16 @@ def clean_legs(skeleton, tgt, rot, mats, contact, legs, times, mapped, heights=N
         below = foot_points(skeleton, leg.foot, mats)[..., 1] - ankle[:, 1:2]
         goal[:, 1] += np.maximum(0.0, tgt.floor - below.min(axis=1) - goal[:, 1])
         solve.append((leg.upper, leg.knee, ankle, goal))
-    return _solve_legs(skeleton, tgt, rot, mats, solve, blend, mapped)
+    return solve_legs(skeleton, tgt, rot, mats, solve, blend, mapped)
 
 
-def _blend_frames(times):
+def blend_frames(times):
+    """Frames over which a contact's hold fades in and out: 0.1 s, at least 2."""
     dt = float(np.median(np.diff(times))) if len(times) > 1 else 1 / 30
     return max(2, int(round(0.1 / dt)))
 
 
-def _solve_legs(skeleton, tgt, rot, mats, legs, blend, mapped):
+def solve_legs(skeleton, tgt, rot, mats, legs, blend, mapped):
     """Lower the hips where a stretched leg cannot reach its goal (by the shortfall, spread
     over the blend window so the body does not jolt), then solve each leg ``(upper, knee,
     ankle (F, 3), goal (F, 3))`` by two-bone IK; joints the map leaves out below the upper
@@ -255,7 +270,7 @@ def _solve_legs(skeleton, tgt, rot, mats, legs, blend, mapped):
         ok_height = np.sqrt(np.maximum(reach ** 2 - horiz ** 2, 0.0))
         drop = np.maximum(drop, np.maximum(0.0, -v[:, 1] - ok_height))
     if drop.any():
-        drop = _smooth_max(drop, blend)
+        drop = smooth_max(drop, blend)
     hips_rot = rot[:, tgt.hips]
     normal = hips_rot @ (rotations_of(tgt.mats)[tgt.hips].T @ tgt.left)
     down = np.c_[np.zeros(n), drop, np.zeros(n)]
@@ -271,7 +286,7 @@ def _solve_legs(skeleton, tgt, rot, mats, legs, blend, mapped):
     return rot, drop
 
 
-def _smooth_max(x, width):
+def smooth_max(x, width):
     """A running maximum over ``2 width + 1`` samples, then a moving average as wide: covers
     every sample's need and ramps in and out."""
     pad = np.pad(x, width, mode="edge")

@@ -44,6 +44,7 @@ from .facing import clip_forward, face_by_hips, heading_degrees
 from .limbs import LegCalibration, ground, leg_contacts
 from .name_map import auto_map
 from .pitch import pitch_body
+from .soles import hold_soles, source_clearance
 from .transfer import transfer_rotations
 from .tree_map import leg_map, legs_agree
 
@@ -212,6 +213,10 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
                                    inverse, heights)
         hips_t = hips_t - np.c_[np.zeros_like(drop), drop, np.zeros_like(drop)]
         mats = assemble(tsk, rot, hips, hips_t)
+        # what the user sees is the skin: its soles on the floor, not only the joints
+        clear = source_clearance(src, smats, s_floor, s_points, scale)
+        rot, hips_t, mats = hold_soles(target_rig, tgt, rot, hips_t, mats, contact, clear,
+                                       times, inverse, target_what)
     clip = to_clip(tsk, mats, rot, times, name or source_clip.name, source_clip, hips,
                    tgt.points[hips])
     return RetargetResult(clip, dict(map), src, tgt, facing, scale, times, smats, raw, mats,

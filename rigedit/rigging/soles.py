@@ -1,0 +1,487 @@
+"""The soles: each foot's skinned vertices, their lowest point per frame, and its slip.
+
+The foot clean-up of :mod:`.contacts` works on joints (ankle, toe, their tails), but what the
+user sees is the skin: a sole lies a few centimetres below the ankle joint, and how far
+depends on the mesh, not on the skeleton. Here each foot is the set of vertices its joints
+dominate in the skin binding (at least :data:`DOMINANT` of their weight on the foot's
+joints: the ankle joint and every joint below it), skinned on their own, and the floor is
+the lowest of those points in the target's calibration pose (its rest: a rest-pose
+character stands on its floor, as the joint clean-up assumes).
+
+Skinning only heights is cheap: a vertex's linear-blend position is linear in its *lifted*
+vector ``z = (w_u [v, 1])_u`` over the U joints the feet use, so the heights of N vertices
+in F frames are one (N, 4U) x (4U, F) matrix product (Xbot's 3,574 foot vertices over CMU
+131_01's 994 frames: a few hundredths of a second).
+
+:func:`hold_soles` then corrects the cleaned-up motion: each foot's lowest skinned point
+lies on the floor during the foot's contacts and never below it, and the point bearing the
+weight does not slide. The ankle's IK goal moves by the difference (the foot keeps its model
+rotation, so its skin moves with the ankle), blended over the contact's fade
+(:func:`rigedit.rigging.contacts.ramp`); outside contacts a sole below the floor is lifted
+(the lift spread over the same window so a swing does not jolt); where a leg cannot reach
+its goal the hips drop (:func:`rigedit.rigging.contacts.solve_legs`).
+
+Pure numpy + scipy.
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .bake import assemble
+from .contacts import blend_frames, ramp, runs, smooth_max, solve_legs
+
+__all__ = ["Soles", "find_soles", "skin_points", "vertex_heights", "sole_heights",
+           "bearing_steps", "sole_slip", "hold_offsets", "source_clearance", "foot_legs",
+           "standing_heights", "raise_body", "hold_soles", "sole_measures",
+           "DOMINANT", "TOLERANCE", "STANDING"]
+
+#: A vertex belongs to a foot when at least this much of its weight is on the foot's joints.
+DOMINANT = 0.5
+#: Corrections stop once every foot's lowest point is within this of its goal, per unit of
+#: hip height (0.1 mm on a figure whose hips stand 1 m high).
+TOLERANCE = 1e-4
+#: A foot in contact stands (on the floor, not sliding) while the source's stands within
+#: this of the lowest it stands in that contact, per unit of hip height (9 mm on a human).
+STANDING = 0.01
+#: Rounds of IK and re-measuring at most: the skin moves with the ankle but for the vertices
+#: the shin shares, and a hips drop moves the other foot.
+ROUNDS = 6
+
+
+@dataclass
+class Soles:
+    """The skinned feet of a rig.
+
+    Attributes
+    ----------
+    joints : list of list of int
+        Per foot, its joints (the ankle and everything below it).
+    vertices : list of (N_i,) int64
+        Per foot, the mesh vertices its joints dominate (never empty).
+    used : (U,) int64
+        The joints those vertices are weighted to (a few: the palette is computed for them
+        alone).
+    lifted : (sum N_i, 4 U) float64
+        Each vertex's lifted vector ``(w_u x, w_u y, w_u z, w_u)`` over ``used``, foot after
+        foot: its skinned position is ``sum_u K_u[:3] (w_u [v, 1])``.
+    floor : float
+        Model y of the lowest sole point in the calibration pose.
+    """
+
+    joints: list
+    vertices: list
+    used: np.ndarray
+    lifted: np.ndarray
+    floor: float = 0.0
+
+    @property
+    def offsets(self):
+        """(n_feet + 1,) where each foot's rows start in :attr:`lifted`."""
+        return np.r_[0, np.cumsum([len(v) for v in self.vertices])]
+
+
+def find_soles(rig, feet, calibration_mats, what="target"):
+    """The feet of ``rig`` on its skin, or None for a rig without a mesh.
+
+    Parameters
+    ----------
+    rig : Rig
+    feet : list of int
+        The ankle joint of each foot; the foot is its subtree.
+    calibration_mats : (J, 4, 4) float64
+        The standing pose the floor is measured in.
+    what : str
+        Names the rig in the warning below.
+
+    Returns
+    -------
+    Soles or None
+        None (with a warning naming the joint) also when some foot dominates no vertex:
+        then the feet are kept on the floor by their joints, as the skin cannot say.
+    """
+    if len(rig.vertices) == 0:
+        return None
+    sk, binding = rig.skeleton, rig.binding
+    weights = sp.csr_matrix(binding.matrix, dtype=np.float64)
+    joints = [list(sk.subtree(a)) for a in feet]
+    vertices = []
+    for ankle, js in zip(feet, joints):
+        share = np.asarray(weights[:, js].sum(axis=1)).ravel()
+        v = np.flatnonzero(share >= DOMINANT)
+        if len(v) == 0:
+            warnings.warn(f"{what}: no vertex is mostly weighted to the foot below "
+                          f"{sk.names[ankle]!r}; the feet are kept on the floor by their "
+                          f"joints, not their skin", stacklevel=2)
+            return None
+        vertices.append(v)
+    allv = np.concatenate(vertices)
+    w = weights[allv]
+    used = np.unique(w.indices)
+    w = w[:, used].toarray()
+    rest = np.c_[binding.rest_vertices[allv], np.ones(len(allv))]
+    lifted = (w[:, :, None] * rest[:, None, :]).reshape(len(allv), 4 * len(used))
+    soles = Soles(joints, vertices, used, lifted)
+    soles.floor = float(sole_heights(soles, sk, calibration_mats[None]).min())
+    return soles
+
+
+def _palette(soles, skeleton, mats):
+    """(F, U, 4, 4) skinning matrices ``M_u . inverse_bind_u`` of the joints used."""
+    return mats[:, soles.used] @ skeleton.inverse_bind_matrices[soles.used][None]
+
+
+def skin_points(soles, skeleton, mats, rows=None):
+    """(F, N, 3) skinned positions (linear blend) of the feet's vertices (``rows`` of them,
+    all by default) in the poses ``mats`` (F, J, 4, 4)."""
+    z = soles.lifted if rows is None else soles.lifted[rows]
+    pal = _palette(soles, skeleton, mats)[:, :, :3, :]            # (F, U, 3, 4)
+    p = z @ pal.transpose(1, 3, 0, 2).reshape(z.shape[1], -1)     # (N, F x 3)
+    return p.reshape(len(z), len(mats), 3).transpose(1, 0, 2)
+
+
+def vertex_heights(soles, skeleton, mats):
+    """(F, N) model y of every foot vertex in the poses ``mats`` (F, J, 4, 4)."""
+    pal = _palette(soles, skeleton, mats)[:, :, 1, :]             # (F, U, 4)
+    return (soles.lifted @ pal.reshape(len(mats), -1).T).T
+
+
+def sole_heights(soles, skeleton, mats, heights=None):
+    """(F, n_feet) model y of each foot's lowest skinned point in each pose (from
+    ``heights``, :func:`vertex_heights` of ``mats``, when given)."""
+    y = vertex_heights(soles, skeleton, mats) if heights is None else heights
+    off = soles.offsets
+    return np.stack([y[:, a:b].min(axis=1) for a, b in zip(off[:-1], off[1:])], axis=1)
+
+
+def bearing_steps(soles, skeleton, mats, heights=None):
+    """How the point each foot stands on moves: per foot, the horizontal (x, z) step from
+    frame ``f`` to ``f + 1`` of the vertex lowest in frame ``f`` (the one bearing the
+    weight).
+
+    Returns
+    -------
+    steps : (F - 1, n_feet, 2) float64
+    """
+    y = vertex_heights(soles, skeleton, mats) if heights is None else heights
+    off = soles.offsets
+    pal = _palette(soles, skeleton, mats)[:, :, [0, 2], :]        # (F, U, 2, 4)
+    pal = pal.transpose(0, 1, 3, 2).reshape(len(mats), -1, 2)     # (F, 4U, 2)
+    out = np.zeros((max(len(mats) - 1, 0), len(off) - 1, 2))
+    for i, (a, b) in enumerate(zip(off[:-1], off[1:])):
+        low = a + np.argmin(y[:-1, a:b], axis=1)
+        z = soles.lifted[low]                                    # (F - 1, 4U)
+        out[:, i] = (np.einsum("fk,fkc->fc", z, pal[1:])
+                     - np.einsum("fk,fkc->fc", z, pal[:-1]))
+    return out
+
+
+def sole_slip(steps, contact):
+    """Slip of a foot's skin during each of its contacts: the horizontal path of the point
+    bearing the weight (:func:`bearing_steps`), summed over each contact's frames. A foot
+    rolling from heel to toe turns about its lowest point and does not slip; one sliding, or
+    turning about its ankle, does.
+
+    Parameters
+    ----------
+    steps : (F - 1, 2) float64
+        One foot's bearing steps.
+    contact : (F,) bool
+
+    Returns
+    -------
+    slips : (C,) float64
+        One per contact run, in model units.
+    """
+    return np.array([float(np.linalg.norm(steps[a:b - 1], axis=1).sum())
+                     for a, b in runs(contact)])
+
+
+def hold_offsets(steps, contact, blend):
+    """Horizontal offsets that stop a foot's skin slipping during its contacts.
+
+    In each contact the foot is moved so that the vertex bearing the weight in a frame
+    stays where it is in the next (the foot turns about the point it stands on: a heel
+    strike rolls onto the ball, a pivot turns about it); the offsets are centred on the
+    contact (the foot stands where it stood on average) and faded in before it and out after
+    it over ``blend`` frames, as :func:`rigedit.rigging.contacts.pin_offsets` fades the
+    joints' pins.
+
+    Parameters
+    ----------
+    steps : (F - 1, 2) float64
+        One foot's bearing steps (:func:`bearing_steps`).
+    contact : (F,) bool
+    blend : int
+
+    Returns
+    -------
+    offsets : (F, 2) float64
+        To add to the foot's x and z.
+    """
+    n = len(contact)
+    out = np.zeros((n, 2))
+    best = np.zeros(n)
+    for a, b in runs(contact):
+        held = np.zeros((b - a, 2))
+        held[1:] = -np.cumsum(steps[a:b - 1], axis=0)
+        held -= held.mean(axis=0)
+        out[a:b], best[a:b] = held, 1.0
+        for k in range(1, blend + 1):
+            w = 1.0 - k / (blend + 1)
+            for f, edge in ((a - k, 0), (b - 1 + k, -1)):
+                if 0 <= f < n and w > best[f]:
+                    best[f], out[f] = w, w * held[edge]
+    return out
+
+
+def source_clearance(src, smats, s_floor, s_points, scale):
+    """How high the source's contact points stand above where they stand standing, scaled
+    to the target: ``scale (y_p(t) - s_floor - y_p(rest))``, the height
+    :func:`rigedit.rigging.contacts.detect_contacts` compares with its tolerance.
+
+    Parameters
+    ----------
+    src : Calibration or LegCalibration
+    smats : (F, Js, 4, 4) float64
+        The source's model matrices over the clip.
+    s_floor : float
+        The motion's floor (model y).
+    s_points : list of int
+        The source joint of each column of the retarget's contacts.
+    scale : float
+        Target / source hip height.
+
+    Returns
+    -------
+    clearance : (F, P) float64
+    """
+    rest = src.mats[s_points, 1, 3] - src.joint_floor
+    return scale * (smats[:, s_points, 1, 3] - s_floor - rest[None])
+
+
+def foot_legs(tgt, contact, clearance=None):
+    """Per foot: its IK joints ``(upper, knee, ankle)``, its contact mask and its source
+    clearance.
+
+    Parameters
+    ----------
+    tgt : Calibration or LegCalibration
+    contact : (F, P) bool
+        The retarget's contacts: a humanoid's left and right ankle, then left and right toe
+        (a foot touches while either does); otherwise one column per leg.
+    clearance : (F, P) float64, optional
+        :func:`source_clearance` of the same columns (zeros by default).
+
+    Returns
+    -------
+    legs : list of (int, int, int)
+    contact : (F, n_feet) bool
+    clearance : (F, n_feet) float64
+        A humanoid foot's is its lower point's (the heel strikes on the ankle's, the toe
+        pushes off on the toe's).
+    """
+    contact = np.asarray(contact, bool)
+    clearance = np.zeros(contact.shape) if clearance is None else clearance
+    if tgt.kind == "humanoid":
+        s = tgt.slots
+        legs = [(s[f"thigh_{k}"], s[f"shin_{k}"], s[f"foot_{k}"]) for k in "LR"]
+        return (legs, contact[:, [0, 1]] | contact[:, [2, 3]],
+                np.minimum(clearance[:, [0, 1]], clearance[:, [2, 3]]))
+    return [(leg.upper, leg.knee, leg.ankle) for leg in tgt.legs], contact, clearance
+
+
+def standing_heights(clearance, contact, blend, tol):
+    """The height a foot's sole keeps during each of its contacts: 0 while the source's
+    foot stands within ``tol`` of the lowest it stands in that contact (mocap feet wobble by
+    millimetres while they bear the weight), above that by as much more as the source's
+    rises (a foot that the contact's tolerance still counts while it lifts, or sets down,
+    lifts and sets down as the source's does, a little later). In the ``blend`` frames
+    either side of a contact, relative to that contact's lowest too.
+
+    Parameters
+    ----------
+    clearance, contact : (F,) float64, (F,) bool
+    blend : int
+    tol : float
+
+    Returns
+    -------
+    heights : (F,) float64
+        Never below 0; the foot *stands* where it is 0 in a contact.
+    """
+    n = len(contact)
+    base = np.full(n, np.nan)
+    for a, b in runs(contact):
+        base[a:b] = clearance[a:b].min()
+    for a, b in runs(contact):
+        for k in range(1, blend + 1):
+            for f in (a - k, b - 1 + k):
+                if 0 <= f < n and np.isnan(base[f]):
+                    base[f] = base[a]
+    return np.maximum(0.0, clearance - np.nan_to_num(base) - tol)
+
+
+def raise_body(weights, change, blend):
+    """How far to raise (or lower) the body so that the feet on the ground move as they must
+    without bending the legs: in each frame where every foot on the ground (weight above 0)
+    must go up, the least they must; where every one must go down, minus the least they
+    must; else 0 (and where none touches); averaged over ``2 blend + 1`` frames so the body
+    does not jolt (the legs' IK takes what is left, either way).
+
+    Parameters
+    ----------
+    weights : (F, n_feet) float64
+        Each foot's contact weight (:func:`rigedit.rigging.contacts.ramp`).
+    change : (F, n_feet) float64
+        The height change each foot's sole needs.
+    blend : int
+
+    Returns
+    -------
+    raise_by : (F,) float64
+    """
+    on = weights > 0
+    up = np.where(on, change, np.inf).min(axis=1)
+    down = np.where(on, change, -np.inf).max(axis=1)
+    need = np.where(up > 0, up, np.where(down < 0, down, 0.0))
+    need[~on.any(axis=1)] = 0.0
+    if not need.any():
+        return need
+    kernel = np.ones(2 * blend + 1) / (2 * blend + 1)
+    return np.convolve(np.pad(need, blend, mode="edge"), kernel, mode="valid")
+
+
+def hold_soles(rig, tgt, rot, hips_pos, mats, contact, clearance, times, mapped,
+               what="target"):
+    """Each foot's lowest skinned point on the floor during its contacts (where the source's
+    foot stands), not sliding, and never below the floor.
+
+    Parameters
+    ----------
+    rig : Rig
+        The target; a rig without a mesh (or with a foot no vertex is mostly weighted to)
+        is returned unchanged: its joints were kept on the floor by :mod:`.contacts`.
+    tgt : Calibration or LegCalibration
+        The target's calibration (the floor is measured in its pose).
+    rot : (F, J, 3, 3) float64
+        Model rotations after the joint clean-up.
+    hips_pos : (F, 3) float64
+        The hips' model position.
+    mats : (F, J, 4, 4) float64
+        ``assemble(rig.skeleton, rot, tgt.hips, hips_pos)``.
+    contact : (F, P) bool
+        See :func:`foot_legs`.
+    clearance : (F, P) float64 or None
+        :func:`source_clearance`: during a contact the sole stands on the floor while the
+        source's foot stands, and lifts as the source's lifts (:func:`standing_heights`);
+        None holds it on the floor throughout.
+    times : (F,) float64
+    mapped : dict or set
+        Target joints the map reaches (others below a leg's top keep their rest pose).
+    what : str
+        Names the target in a warning.
+
+    Returns
+    -------
+    rot, hips_pos, mats
+        Corrected, in the same shapes (the inputs are not changed).
+    """
+    sk = rig.skeleton
+    legs, touch, clear = foot_legs(tgt, contact, clearance)
+    soles = find_soles(rig, [ankle for *_, ankle in legs], tgt.mats, what)
+    if soles is None:
+        return rot, hips_pos, mats
+    blend = blend_frames(times)
+    w = np.stack([ramp(touch[:, i], blend) for i in range(len(legs))], axis=1)
+    tol = TOLERANCE * tgt.hip_height
+    stand = np.stack([standing_heights(clear[:, i], touch[:, i], blend,
+                                       STANDING * tgt.hip_height)
+                      for i in range(len(legs))], axis=1)
+    rot, hips_pos = rot.copy(), np.array(hips_pos, dtype=np.float64)
+    y = vertex_heights(soles, sk, mats)
+    low = sole_heights(soles, sk, mats, y) - soles.floor
+    # where every foot on the ground sinks (the joints stand where they should but the skin
+    # reaches lower than they say), the body rises, where every one floats it sinks: the
+    # legs keep the source's directions
+    raise_by = raise_body(w, stand - low, blend)
+    if raise_by.any():
+        hips_pos[:, 1] += raise_by
+        mats = assemble(sk, rot, tgt.hips, hips_pos)
+        y = vertex_heights(soles, sk, mats)
+        low = sole_heights(soles, sk, mats, y) - soles.floor
+    # outside contacts only lift (spread over the fade so a swing does not kink); inside them
+    # the sole stands where the source's does; in the fade between, a blend, never below
+    lift = np.where(w >= 1.0, 0.0, np.maximum(0.0, -low))
+    lift = np.stack([smooth_max(c, blend) if c.any() else c for c in lift.T], axis=1)
+    goal = w * stand + (1 - w) * (low + lift)
+    # the skin does not slide while it stands (the joints' pins hold the ankle and toe, but
+    # a foot turning about its ankle still slides its sole); a foot the source lifts is free
+    held = touch & (stand == 0)
+    gain = np.ones_like(low)
+    for _ in range(ROUNDS):
+        steps = bearing_steps(soles, sk, mats, y)
+        across = np.stack([hold_offsets(steps[:, i], held[:, i], blend)
+                           for i in range(len(legs))], axis=1)
+        if max(np.abs(goal - low).max(), np.abs(across).max()) <= tol:
+            break
+        change = (goal - low) / gain
+        solve = []
+        for i, (upper, knee, ankle) in enumerate(legs):
+            at = mats[:, ankle, :3, 3]
+            move = np.c_[across[:, i, 0], change[:, i], across[:, i, 1]]
+            solve.append((upper, knee, at, at + move))
+        rot, drop = solve_legs(sk, tgt, rot, mats, solve, blend, mapped)
+        hips_pos[:, 1] -= drop
+        mats = assemble(sk, rot, tgt.hips, hips_pos)
+        y = vertex_heights(soles, sk, mats)
+        before, low = low, sole_heights(soles, sk, mats, y) - soles.floor
+        # how far the sole moved per unit the ankle did (under 1 where the knee's bone
+        # carries part of the sole, over 1 where its turn swings a long foot): the next
+        # round divides by it, a secant step per frame and foot
+        moved = np.abs(change) > tol
+        gain = np.where(moved, np.clip((low - before) / np.where(moved, change, 1.0),
+                                       0.3, 3.0), gain)
+    return rot, hips_pos, mats
+
+
+def sole_measures(result, rig):
+    """How a retarget's feet stand on the skin: the figures of ``benchmarks/bench_soles.py``.
+
+    Parameters
+    ----------
+    result : RetargetResult
+        A retarget onto ``rig`` (a rig with a mesh whose feet have vertices).
+    rig : Rig
+
+    Returns
+    -------
+    dict
+        ``lowest``: the lowest sole point over the clip above the floor (negative: below);
+        ``below``: the share of frames in which a sole is more than 1 mm below it;
+        ``standing``: the sole's height in the worst standing frame of a contact (where the
+        source's foot stands: :func:`standing_heights` is 0), signed; ``slips``: (C,) slip
+        per contact over its standing frames (:func:`sole_slip`); ``floor``: the floor's
+        model y. Lengths in model units.
+    """
+    tgt = result.target_calibration
+    clear = source_clearance(result.source_calibration, result.source_mats,
+                             result.source_floor, result.source_contacts, result.scale)
+    legs, touch, clear = foot_legs(tgt, result.contact, clear)
+    soles = find_soles(rig, [a for *_, a in legs], tgt.mats)
+    y = vertex_heights(soles, rig.skeleton, result.mats)
+    low = sole_heights(soles, rig.skeleton, result.mats, y) - soles.floor
+    steps = bearing_steps(soles, rig.skeleton, result.mats, y)
+    standing, slips = 0.0, []
+    for i in range(len(legs)):
+        stand = touch[:, i] & (standing_heights(clear[:, i], touch[:, i], 0,
+                                                STANDING * tgt.hip_height) == 0)
+        if stand.any():
+            worst = low[stand, i][np.argmax(np.abs(low[stand, i]))]
+            standing = worst if abs(worst) > abs(standing) else standing
+            slips.extend(sole_slip(steps[:, i], stand))
+    return dict(lowest=float(low.min()), below=float((low < -1e-3).any(axis=1).mean()),
+                standing=float(standing), slips=np.array(slips), floor=soles.floor)
