@@ -109,3 +109,30 @@ def test_bvh_carrier_in_millimetres(tmp_path):
     rig, said = _load(humanoid_bvh(carrier="joint_Root", start=(0, 0, -540), unit=10.0),
                       tmp_path)
     assert "guessed millimetres" in said[0] and "1.73 m" in said[0]
+
+
+def test_render_frames_and_follows_the_figure_not_the_carrier(tmp_path):
+    """rigedit render of the carrier-root walk framed the static carrier and the whole 2.4 m
+    path (a small figure at the edge): the camera follows the hips, the carrier is left out."""
+    from rigedit.render.camera import figure_joints, rest_points, swept_points
+
+    rig, _ = _load(humanoid_bvh(carrier="joint_Root", start=(0, 0, -540)), tmp_path)
+    clip = rig.clips["take"]
+    carriers, follow = figure_joints(rig, clip)
+    assert carriers.tolist() == [True] + [False] * (len(carriers) - 1)
+    assert rig.skeleton.names[follow] == "Hips"   # the carrier stays behind
+    times = np.arange(0, clip.duration, 1 / 30)
+    pts = swept_points(rig, clip, times)
+    extent = np.ptp(pts, axis=0)
+    assert extent.max() < 1.9, extent            # the figure, followed: not 5.4 m or 2.4 m
+    assert np.all(pts[:, 2] < -4.5)              # never the carrier at the origin
+    assert np.ptp(rest_points(rig), axis=0).max() < 4.0   # its walk, not the origin too
+
+
+def test_camera_follows_a_carrier_that_travels_with_the_figure(humanoid):
+    """The bundled humanoid's root walks on the floor under its hips: the camera follows it
+    (smoother than the hips' sway), and it is not framed."""
+    from rigedit.render.camera import figure_joints
+
+    carriers, follow = figure_joints(humanoid, humanoid.clips["walk"])
+    assert humanoid.skeleton.names[follow] == "root" and carriers[follow]

@@ -6,16 +6,20 @@ the same functions: :func:`frame_view` turns a preset ("front", "side", "top", "
 angle into a camera placed at the distance where the given points just fit the window;
 :func:`swept_points` gives the points a clip's motion covers so a recording frames the whole
 motion; :func:`camera_state` and :func:`apply_camera` copy the editor's view into a recording.
-Never imports Qt.
+What is framed and followed is the figure: a carrier root (:mod:`rigedit.model.carrier`: a
+joint at the origin or on the floor that only carries the figure, which may walk metres away
+from it) is neither framed nor followed (:func:`figure_joints`). Never imports Qt.
 """
 from __future__ import annotations
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ..model.carrier import carrier_joints, figure_root
+
 __all__ = ["up_vector", "front_vector", "turn_about", "horizontal", "joint_points",
            "rest_points", "frame_view", "fit_distance", "swept_points", "camera_state",
-           "apply_camera"]
+           "apply_camera", "figure_joints"]
 
 
 def up_vector(up):
@@ -42,7 +46,7 @@ def horizontal(offset, up):
     return offset - np.dot(offset, up) * up
 
 
-def joint_points(rig, model):
+def joint_points(rig, model, carriers=None):
     """(J + T, 3) what a mesh-less rig shows of a pose: its joints and bone tails.
 
     Parameters
@@ -50,8 +54,53 @@ def joint_points(rig, model):
     rig : Rig
     model : (J, 4, 4) float64
         Model matrices of the pose.
+    carriers : (J,) bool, optional
+        Joints to leave out, with their tails (carrier roots: :func:`figure_joints`).
     """
-    return np.vstack([model[:, :3, 3], rig.posed_tails(model)[1]])
+    if carriers is None or not np.any(carriers):
+        return np.vstack([model[:, :3, 3], rig.posed_tails(model)[1]])
+    owners, tails = rig.posed_tails(model)
+    keep = ~np.asarray(carriers)
+    return np.vstack([model[keep, :3, 3], tails[keep[np.asarray(owners, dtype=int)]]])
+
+
+def figure_joints(rig, clip=None, samples=12):
+    """The rig's carrier roots and the joint the camera follows (the figure's root).
+
+    Parameters
+    ----------
+    rig : Rig
+    clip : Clip, optional
+        Carriers are judged over ``samples`` poses of it (a carrier may stand at the figure's
+        feet at rest and metres away during the clip); the rest pose without one.
+
+    Returns
+    -------
+    carriers : (J,) bool
+    follow : int
+        The joint whose horizontal motion the camera follows: the topmost carrier that
+        travels with the figure (the bundled characters' root, on the floor under the hips:
+        smoother than the hips' sway), else the first joint below the carriers (the hips,
+        when the carrier stays behind at the origin), else joint 0.
+    """
+    sk = rig.skeleton
+    pose = rig.rest_pose()
+    if clip is None or not clip.tracks:
+        poses = [rig.joint_matrices(pose)[:, :3, 3]]
+    else:
+        poses = [rig.joint_matrices(clip.sample(t, out=pose))[:, :3, 3]
+                 for t in np.linspace(0.0, clip.duration, samples)]
+    poses = np.stack(poses)
+    up = up_vector(rig.up)
+    carriers = carrier_joints(sk.parents, poses, up)
+    root = figure_root(sk.parents, carriers)
+    reach = 0.25 * (float(np.ptp(poses[:, ~carriers] @ up)) or 1.0)
+    along = []
+    for c in np.flatnonzero(carriers):
+        gap = poses[:, c] - poses[:, root]
+        if np.all(np.linalg.norm(gap - (gap @ up)[:, None] * up, axis=1) < reach):
+            along.append(int(c))
+    return carriers, along[0] if along else root
 
 
 def rest_points(rig, samples=12):
@@ -64,10 +113,12 @@ def rest_points(rig, samples=12):
         # a frame of its own (CesiumMan's is Z up) that only its joints place
         return rig.skin(rig.rest_pose())[::max(1, len(rig.vertices) // 4000)]
     clip = next(iter(rig.clips.values()), None)
+    carriers, _ = figure_joints(rig, clip, samples)
     if clip is None or not clip.tracks:
-        return joint_points(rig, rig.skeleton.bind_matrices)
+        return joint_points(rig, rig.skeleton.bind_matrices, carriers)
     pose = rig.rest_pose()
-    return np.concatenate([joint_points(rig, rig.joint_matrices(clip.sample(t, out=pose)))
+    return np.concatenate([joint_points(rig, rig.joint_matrices(clip.sample(t, out=pose)),
+                                        carriers)
                            for t in np.linspace(0.0, clip.duration, samples)])
 
 
@@ -135,9 +186,10 @@ def fit_distance(points, center, direction, cam_up, view_angle, window_size, mar
 
 
 def swept_points(rig, clip, times, samples=12, per_frame=3000):
-    """Vertices the clip sweeps over the recorded times, with the root's horizontal motion
-    taken out (the camera follows it), to frame the whole motion. A rig without a mesh is
-    framed by its joints (and bone tails) instead.
+    """Vertices the clip sweeps over the recorded times, with the figure root's horizontal
+    motion taken out (the camera follows it: :func:`figure_joints`), to frame the whole
+    motion. A rig without a mesh is framed by its joints (and bone tails) instead, carrier
+    roots left out.
 
     Returns
     -------
@@ -147,14 +199,16 @@ def swept_points(rig, clip, times, samples=12, per_frame=3000):
     if clip is None:
         return rig.vertices[::step] if len(rig.vertices) else rig.bounds()
     up = up_vector(rig.up)
+    carriers, follow = figure_joints(rig, clip, samples)
     pose = rig.rest_pose()
     pts, root0 = [], None
     for t in np.linspace(times[0], times[-1], min(samples, len(times))):
         clip.sample(t, out=pose)
         model = rig.joint_matrices(pose)
-        root = model[0, :3, 3]
+        root = model[follow, :3, 3]
         root0 = root if root0 is None else root0
-        shown = rig.skin(pose)[::step] if len(rig.vertices) else joint_points(rig, model)
+        shown = rig.skin(pose)[::step] if len(rig.vertices) else \
+            joint_points(rig, model, carriers)
         pts.append(shown - horizontal(root - root0, up))
     return np.concatenate(pts)
 

@@ -24,7 +24,7 @@ import pyvista as pv
 
 from ..errors import RigFileError
 from ..io.atomic import check_output_folder
-from .camera import apply_camera, horizontal, swept_points, turn_about
+from .camera import apply_camera, figure_joints, horizontal, swept_points, turn_about
 from .floor import GRID_COLOR
 from .scene import RigScene
 from .video_writer import FrameReader, RecordingCancelled, ThreadedWriter, VideoWriter
@@ -75,7 +75,8 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
     orbit : float
         Degrees the camera turns about the vertical axis over the recording.
     follow_root : bool
-        Move the camera with the root joint's horizontal motion (walks stay in frame).
+        Move the camera with the figure root's horizontal motion (walks stay in frame): the
+        hips when a carrier root carries them (:func:`rigedit.render.camera.figure_joints`).
     show_skeleton, show_floor : bool
     multi_samples : int
         Anti-aliasing samples (0 is several times faster in software OpenGL).
@@ -141,7 +142,8 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         model0 = scene.update(pose)
         base_pos = np.array(plotter.camera.position)
         base_focal = np.array(plotter.camera.focal_point)
-        root0 = model0[0, :3, 3].copy()
+        follow = figure_joints(rig, clip)[1]   # the hips, not a carrier root left behind
+        root0 = model0[follow, :3, 3].copy()
         up = scene.up
         camera = plotter.camera
         # pyvista's render() does nothing until a first show() or screenshot()
@@ -153,7 +155,8 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
             if clip is not None:
                 clip.sample(t, out=pose)
             model = scene.update(pose)
-            shift = horizontal(model[0, :3, 3] - root0, up) if follow_root else np.zeros(3)
+            shift = horizontal(model[follow, :3, 3] - root0, up) if follow_root else \
+                np.zeros(3)
             rel = base_pos - base_focal
             if orbit:
                 rel = turn_about(rel, up, orbit * i / max(len(times), 1))
