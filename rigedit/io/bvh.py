@@ -27,11 +27,10 @@ and the figure's size leaves them out.
 
 Units: BVH has none. ``scale`` (metres per file unit) converts; when it is omitted the unit
 is guessed from the figure's size (its largest extent over sampled frames, 90th percentile,
-carrier roots left out; see :func:`guess_unit`): the unit that makes it a human's 1.2-2.2 m, else the nearest
-and NOT SURE. The guess is reported in a :class:`BvhUnitsWarning` and in
-``rig.notes["units"]``. Frames: BVH is
-conventionally Y up, rigedit's own convention, so axes are kept as they are
-(``rig.notes["frames"]`` says so).
+carrier roots left out; see :func:`guess_unit`): the unit that makes it a human's
+1.2-2.2 m, else the nearest, NOT SURE. The guess is reported in a :class:`BvhUnitsWarning`
+and in ``rig.notes["units"]``. Frames: BVH is conventionally Y up, rigedit's own convention,
+so axes are kept as they are (``rig.notes["frames"]`` says so).
 """
 from __future__ import annotations
 
