@@ -177,14 +177,14 @@ def _run(argv, capsys):
 
 def test_cli_errors_name_the_file(tmp_path, capsys, humanoid):
     ref = humanoid
-    # an open mesh: the body without its head and shoulders
-    keep = ref.vertices[ref.faces].mean(axis=1)[:, 1] < 1.3
+    # a mesh with no volume: the body's front half, a shell without a back
+    keep = ref.vertices[ref.faces].mean(axis=1)[:, 2] > 0.0
     open_mesh = tmp_path / "open.obj"
     save_obj(open_mesh, ref.vertices, ref.faces[keep])
     code, out, err = _run(["autorig", str(open_mesh), "-o", str(tmp_path / "o.glb")], capsys)
     assert code == 2 and err.count("\n") == 1
-    assert err.startswith(f"rigedit: error: {open_mesh}: ") and "hole" in err
-    assert "closed mesh" in err
+    assert err.startswith(f"rigedit: error: {open_mesh}: no volume") and "hole" in err
+    assert "an open shell or sheet" in err
     # a point cloud
     cloud = tmp_path / "cloud.ply"
     cloud.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"

@@ -111,9 +111,91 @@ class MeshCheck:
         return out
 
 
+def _read_gltf(path):
+    """(vertices, faces, surface or None) of a glTF to auto-rig.
+
+    A file whose meshes are all bound to one skin is read as the editor reads it (skinned at
+    its rest pose, with its look). Otherwise (no skin: a static asset; or parts that hang
+    from nodes or from a second skin, as RobotExpressive's body parts hang from its bones
+    and only its hands are skinned) every triangle primitive of every mesh node is placed
+    where the file puts it: a skinned one by its skin at the nodes' default pose (the node's
+    own transform ignored, as the spec says), any other by its node's world matrix. Morph
+    targets are left out (the base shape).
+    """
+    from dataclasses import replace
+
+    from ..io.gltf_data import GltfData
+    from ..io.gltf_read import load_gltf
+
+    data = GltfData(path)
+    nodes = data.gltf.nodes or []
+    meshed = [i for i, n in enumerate(nodes) if n.mesh is not None]
+    skins = {nodes[i].skin for i in meshed}
+    if meshed and len(skins) == 1 and None not in skins:
+        rig = load_gltf(path)
+        vertices = rig.skin(rig.rest_pose()) if len(rig.vertices) else rig.vertices
+        surface = replace(rig.surface, normals=None) if rig.surface is not None else None
+        return np.asarray(vertices, dtype=np.float64), rig.faces, surface
+    try:
+        return _gltf_meshes(data, meshed)
+    except (TypeError, ValueError, KeyError, IndexError, AttributeError) as exc:
+        raise RigFileError(path, f"expected valid glTF meshes, got a malformed field "
+                                 f"({type(exc).__name__}: {exc})") from None
+
+
+def _gltf_meshes(data, meshed):
+    """Every triangle primitive of the nodes ``meshed``, placed (see :func:`_read_gltf`)."""
+    from ..io.gltf_mesh import TRIANGLES, triangles
+    from ..io.gltf_read import _local_matrix, _node_parents
+
+    nodes = data.gltf.nodes
+    parent = _node_parents(data)
+    world = [None] * len(nodes)
+
+    def world_of(i):
+        if world[i] is None:
+            local = _local_matrix(data, i)
+            world[i] = local if parent[i] < 0 else world_of(parent[i]) @ local
+        return world[i]
+
+    verts, faces, offset = [], [], 0
+    for i in meshed:
+        node = nodes[i]
+        skin = data.gltf.skins[node.skin] if node.skin is not None else None
+        palette = None
+        if skin is not None:
+            ibm = (data.accessor(skin.inverseBindMatrices).reshape(-1, 4, 4).transpose(0, 2, 1)
+                   if skin.inverseBindMatrices is not None
+                   else np.tile(np.eye(4), (len(skin.joints), 1, 1)))
+            palette = np.array([world_of(j) for j in skin.joints]) @ ibm
+        for prim in data.gltf.meshes[node.mesh].primitives or []:
+            mode = TRIANGLES if prim.mode is None else prim.mode
+            if mode not in (4, 5, 6) or prim.attributes.POSITION is None:
+                continue
+            pos = data.accessor(prim.attributes.POSITION)[:, :3]
+            idx = (np.arange(len(pos)) if prim.indices is None else
+                   data.accessor(prim.indices)[:, 0].astype(np.int64))
+            h = np.c_[pos, np.ones(len(pos))]
+            if palette is None:
+                placed = h @ world_of(i).T
+            else:
+                j = data.accessor(prim.attributes.JOINTS_0).astype(np.int64)
+                w = data.accessor(prim.attributes.WEIGHTS_0)
+                w = w / np.maximum(w.sum(axis=1, keepdims=True), 1e-12)
+                blend = np.einsum("vk,vkij->vij", w, palette[np.clip(j, 0, len(palette) - 1)])
+                placed = np.einsum("vij,vj->vi", blend, h)
+            verts.append(placed[:, :3])
+            faces.append(triangles(idx, mode) + offset)
+            offset += len(pos)
+    if not verts:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), None
+    return np.concatenate(verts), np.concatenate(faces), None
+
+
 def read_mesh(path, with_surface=False):
     """Vertices and faces of a mesh file to auto-rig: any format :func:`rigedit.io.mesh.load_mesh`
-    reads, or a ``.glb``/``.gltf`` (its skinned mesh at the rest pose when it has a skin).
+    reads, or a ``.glb``/``.gltf``: its skinned mesh at the rest pose when that is all its
+    geometry, else every mesh of the file where the file places it (see :func:`_read_gltf`).
 
     Parameters
     ----------
@@ -121,7 +203,8 @@ def read_mesh(path, with_surface=False):
     with_surface : bool
         Also return the glTF's texture coordinates and materials (a
         :class:`rigedit.surface.Surface` without normals: the file's are in its bind frame;
-        None for other formats), so an auto-rigged character keeps its look.
+        None for other formats and for a glTF read mesh by mesh), so an auto-rigged
+        character keeps its look.
 
     Returns
     -------
@@ -138,15 +221,7 @@ def read_mesh(path, with_surface=False):
     path = Path(path)
     surface = None
     if path.suffix.lower() in (".glb", ".gltf"):
-        from dataclasses import replace
-
-        from ..io.gltf_read import load_gltf
-
-        rig = load_gltf(path)
-        faces = rig.faces
-        vertices = rig.skin(rig.rest_pose()) if len(rig.vertices) else rig.vertices
-        if rig.surface is not None:
-            surface = replace(rig.surface, normals=None)
+        vertices, faces, surface = _read_gltf(path)
     else:
         from ..io.mesh import load_mesh
 
