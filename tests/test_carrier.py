@@ -136,3 +136,26 @@ def test_camera_follows_a_carrier_that_travels_with_the_figure(humanoid):
 
     carriers, follow = figure_joints(humanoid, humanoid.clips["walk"])
     assert humanoid.skeleton.names[follow] == "root" and carriers[follow]
+
+
+def test_cli_render_of_a_far_carrier_walk_frames_the_figure(tmp_path):
+    """The rendered figure is big and centred in every frame: its bones' pixels span most of
+    the picture's height (before: framed with the carrier 5.4 m away, the figure a third of
+    the picture high, near its top)."""
+    import imageio.v2 as imageio
+
+    from rigedit.cli import main
+
+    src = tmp_path / "far.bvh"
+    src.write_text(humanoid_bvh(carrier="joint_Root", start=(0, 0, -540)))
+    out = tmp_path / "far.gif"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main(["render", "take", "--rig", str(src), "-o", str(out), "--size",
+                     "160x120", "--fps", "3", "-q"]) == 0
+    for frame in imageio.mimread(out):
+        f = frame[..., :3].astype(int)
+        rows, cols = np.nonzero(f[..., 2] > f[..., 0] + 60)   # the bones: blue
+        lo, hi = np.percentile(rows, [5, 95])   # (not a stray dot at the origin)
+        assert hi - lo > 0.5 * f.shape[0], (lo, hi)
+        assert abs(np.median(cols) - f.shape[1] / 2) < 0.2 * f.shape[1]
