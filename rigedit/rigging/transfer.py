@@ -9,7 +9,8 @@ from .calibrate import rotations_of, swing, unit
 from .chains import distribute_bend
 from .limbs import ancestors
 
-__all__ = ["transfer_rotations", "end_spec", "end_points", "FLAT_AGREE"]
+__all__ = ["transfer_rotations", "end_spec", "end_points", "pitch_of", "pitched",
+           "FLAT_AGREE"]
 
 #: Degrees within which the source's rest foot and its median foot during contacts are taken
 #: for the same flat foot (then the rest's is used).
@@ -108,18 +109,18 @@ def transfer_rotations(src, tgt, inverse, smats, scal, rf, contact):
             u = t_rot_c[j].T @ vt
             want = end_points(smats, s_spec) - smats[:, s, :3, 3]
             if j in flat:
-                pitch = _pitch(want[flat[j]]) if flat[j].any() else _pitch(vs)
+                pitch = pitch_of(want[flat[j]]) if flat[j].any() else pitch_of(vs)
                 s_flat = float(np.median(pitch))
                 # a standing rest whose foot agrees with the clip's flat foot is the better
                 # measure of it (the median over contacts carries the foot's roll and curled
                 # toes: Xbot's toes stand 5-7 degrees up in its own clips): so a character's
                 # own clip keeps its feet exactly
-                if src.source == "rest" and abs(s_flat - _pitch(vs)) < np.radians(FLAT_AGREE):
-                    s_flat = float(_pitch(vs))
+                if src.source == "rest" and abs(s_flat - pitch_of(vs)) < np.radians(FLAT_AGREE):
+                    s_flat = float(pitch_of(vs))
                 # a target calibrated on a clip's frame (its rest does not stand) has no known
                 # flat foot: the foot points as the source's
-                t_flat = _pitch(vt) if tgt.source == "rest" else s_flat
-                want = _pitched(want, s_flat - t_flat)
+                t_flat = pitch_of(vt) if tgt.source == "rest" else s_flat
+                want = pitched(want, s_flat - t_flat)
             r = swing(r @ u, want) @ r
             pairs.append((j, t_spec, s, s_spec))
         rot[:, j] = r
@@ -128,13 +129,13 @@ def transfer_rotations(src, tgt, inverse, smats, scal, rf, contact):
     return rot, pairs
 
 
-def _pitch(v):
+def pitch_of(v):
     """Angle (radians) of direction(s) ``v`` (..., 3) below the horizontal."""
     v = unit(v)
     return np.arcsin(np.clip(-v[..., 1], -1.0, 1.0))
 
 
-def _pitched(v, delta):
+def pitched(v, delta):
     """Directions ``v`` (F, 3) turned up by ``delta`` radians about their horizontal normal."""
     axis = unit(np.cross(v, [0.0, 1.0, 0.0]))
     rv = Rotation.from_rotvec(axis * delta)
