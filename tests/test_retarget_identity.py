@@ -18,7 +18,7 @@ from rigedit.model import Skeleton
 from rigedit.rig import Rig
 from rigedit.rigging import retarget_result
 from rigedit.rigging.calibrate import model_stack
-from rigedit.rigging.measure import direction_errors
+from rigedit.rigging.measure import direction_errors, lowest_foot
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"
@@ -195,3 +195,17 @@ def test_identity_after_the_foot_clean_up_keeps_the_upper_body(case):
     err = direction_errors(retarget_result(rig, clip, rig))
     upper = [g for g in ("arms", "spine", "head", "fingers", "tail") if g in err]
     assert max(err[g] for g in upper if np.isfinite(err[g])) < 0.5, err
+
+
+def test_another_motion_onto_a_centimetre_skeleton_stands_on_its_floor(humanoid):
+    """The Bandai-style failure on Mixamo characters (bones 35-49 degrees off, feet 0.6-0.9 m
+    above the floor) was the same missing scale: the humanoid's walk onto its centimetre
+    copy points every bone as the source's and keeps the feet on the floor."""
+    cm = _centimetre_copy(humanoid)
+    res = retarget_result(humanoid, "walk", cm)
+    err = direction_errors(res)
+    assert max(err[g] for g in ("arms", "spine", "head")) < 0.01, err
+    assert err["legs"] < 5.0, err
+    raw = direction_errors(res, res.raw_mats)
+    assert max(raw[g] for g in ("arms", "legs", "spine", "head")) < 0.01, raw
+    assert abs(lowest_foot(res)) < 0.01  # metres, whatever the skeleton's units
