@@ -74,3 +74,34 @@ def test_standing_rest_keeps_its_forward(tmp_path, humanoid):
     assert res.source_calibration.source == "rest" and res.facing_degrees == 0
     rel = relative_heading(res.target_calibration, res.mats, res.times)
     assert np.nanmin(np.abs(rel)) > 170   # the target walks backwards too
+
+
+def test_shared_clips_are_sure_of_their_facing(humanoid):
+    """No doubt on the shared clips that travel or stand facing one way."""
+    from test_io_bvh import DATA, shared
+
+    for path in sorted(DATA.glob("bvh-library/bandai-2/*.bvh")):
+        res = retarget_result(_load_shared(shared(str(path.relative_to(DATA)))), "take",
+                              humanoid)
+        assert res.facing_note == "", (path.name, res.facing_note)
+
+
+def _load_shared(path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return load_bvh(path)
+
+
+def test_a_spin_says_its_facing_is_a_guess(tmp_path, humanoid):
+    text = humanoid_bvh(SECONDS, velocity=(0, 0, 0), yaw=lambda t: 360.0 * t / SECONDS,
+                        lying=True)
+    res = retarget_result(_load(tmp_path, text), "take", humanoid)
+    assert "face every way" in res.facing_note
+
+
+def test_walking_backwards_from_frame_0_says_so(tmp_path, humanoid):
+    text = humanoid_bvh(velocity=(0, 0, -100), lying=True)
+    res = retarget_result(_load(tmp_path, text), "take", humanoid)
+    assert "face away from their path" in res.facing_note
+    # it walks backwards still, as the source does
+    assert np.nanmax(np.abs(heading_offsets(res))) < 2.0

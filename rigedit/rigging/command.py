@@ -55,6 +55,9 @@ def run_retarget(args, load):
           f"{res.target_calibration.source}; facing turn {res.facing_degrees:g} deg; "
           f"scale {res.scale:.3f}; contact frames {res.contact.any(axis=1).sum()} of "
           f"{len(res.times)}")
+    if res.facing_note:
+        print(f"rigedit: warning: {args.motion}: NOT SURE of the facing: {res.facing_note}",
+              file=sys.stderr)
     tgt = res.target_calibration
     if tgt.kind == "legs":  # not two humanoids: say which legs were found
         feet = ", ".join(target.skeleton.names[j] for j in tgt.contacts)

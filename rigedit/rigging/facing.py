@@ -25,13 +25,17 @@ import numpy as np
 
 from .calibrate import rotations_of, unit
 
-__all__ = ["hips_forward", "pose_forward", "clip_forward", "heading_degrees",
-           "relative_heading", "heading_offsets", "face_by_hips", "PATH_WINDOW", "MIN_SPEED"]
+__all__ = ["hips_forward", "pose_forward", "clip_forward", "facing_doubt", "heading_degrees",
+           "relative_heading", "heading_offsets", "face_by_hips", "PATH_WINDOW", "MIN_SPEED",
+           "MIN_AGREEMENT"]
 
 #: Seconds over which the hips' direction of travel is measured (a stride's sway averages out).
 PATH_WINDOW = 0.5
 #: Frames where the hips travel slower than this (leg lengths per second) have no path.
 MIN_SPEED = 0.3
+#: A clip whose hips' forward, averaged over its frames as unit vectors, is shorter than
+#: this faces no one way (a spin).
+MIN_AGREEMENT = 0.5
 
 _UP = np.array([0.0, 1.0, 0.0])
 
@@ -86,6 +90,31 @@ def clip_forward(calib, mats):
         return _horizontal(calib.forward)
     mean = pose_forward(calib, mats).mean(axis=0)
     return _horizontal(mean) if np.linalg.norm(mean) > 1e-6 else _horizontal(calib.forward)
+
+
+def facing_doubt(calib, mats, times):
+    """One line saying why the facing turn of a clip may be wrong, or "" when it is sure.
+
+    Doubtful: a clip whose hips face every way (the mean of their forward over the frames is
+    shorter than :data:`MIN_AGREEMENT`: a spin), and a clip whose hips face away from their
+    path in most travelling frames (a backward walk, or left and right swapped). A rest that
+    stands is never doubted (its forward is the rig's). Where a clip faces halfway between
+    two quarter turns of the target's forward the turn is a toss-up too, but either keeps
+    the hips' heading relative to the path, so it is not reported.
+    """
+    if calib.source == "rest" or not len(mats):
+        return ""
+    forwards = pose_forward(calib, mats)
+    agree = float(np.linalg.norm(forwards.mean(axis=0)))
+    if agree < MIN_AGREEMENT:
+        return (f"the source's hips face every way over the clip (their mean forward is "
+                f"{agree:.2f} long): the facing turn is a guess")
+    rel = relative_heading(calib, mats, times)
+    moving = np.isfinite(rel)
+    if moving.sum() >= 0.5 * len(rel) and np.mean(np.abs(rel[moving]) > 135.0) > 0.5:
+        return ("the source's hips face away from their path in most frames (a backward "
+                "walk, or its left and right swapped)")
+    return ""
 
 
 def heading_degrees(v):

@@ -40,7 +40,7 @@ from ..animation.clip import Clip
 from .bake import assemble, to_clip
 from .calibrate import calibrate, model_stack
 from .contacts import clean_feet as hold_feet, clean_legs, detect_contacts
-from .facing import clip_forward, face_by_hips, heading_degrees
+from .facing import clip_forward, face_by_hips, facing_doubt, heading_degrees
 from .limbs import LegCalibration, ground, leg_contacts
 from .name_map import auto_map
 from .pitch import pitch_body
@@ -79,6 +79,8 @@ class RetargetResult:
         source bone.
     source_contacts, target_contacts : list of int
         The source and target joints of the contact points (the columns of ``contact``).
+    facing_note : str
+        Why the facing turn may be wrong (:func:`.facing.facing_doubt`), or "" when sure.
     """
 
     clip: Clip
@@ -96,6 +98,7 @@ class RetargetResult:
     pairs: list = field(default_factory=list)
     source_contacts: list = field(default_factory=list)
     target_contacts: list = field(default_factory=list)
+    facing_note: str = ""
 
 
 def _sample_times(clip):
@@ -170,6 +173,7 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
     face_by_hips(src)
     face_by_hips(tgt)
     facing, rf = _facing(src, tgt, smats)
+    facing_note = facing_doubt(src, smats, times)
     turn = np.eye(4)
     turn[:3, :3] = rf
     smats = turn @ smats
@@ -220,7 +224,8 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
     clip = to_clip(tsk, mats, rot, times, name or source_clip.name, source_clip, hips,
                    tgt.points[hips])
     return RetargetResult(clip, dict(map), src, tgt, facing, scale, times, smats, raw, mats,
-                          contact, s_floor, pairs, list(s_points), list(tgt.contacts))
+                          contact, s_floor, pairs, list(s_points), list(tgt.contacts),
+                          facing_note)
 
 
 def _calibrate_pair(ssk, s_clips, tsk, t_clips, s_what, t_what):
