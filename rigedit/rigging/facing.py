@@ -3,8 +3,9 @@
 A figure's forward at its calibration decides two things in a retarget (:mod:`.retarget`):
 the turn about the vertical that brings the source's facing onto the target's, and the
 body frame each mapped bone is aligned in (:mod:`.transfer`), so that the target's hips face
-as the source's do. Heel to toe in one pose is a poor forward: mid-stride the feet point 30
-degrees off the pelvis, and frame 0 of a dash may face across the way it then runs. So:
+as the source's do. Heel to toe in one pose is a poor forward: mid-stride the feet may point
+far off the pelvis (frame 0 of Bandai's dataset-2 run: 90 degrees), and frame 0 of a dash may
+face across the way it then runs. So:
 
 - the forward of a pose is the **pelvis'**: horizontal, square to the line from the right
   thigh joint to the left one (a humanoid: which is left comes from the joint names, else
