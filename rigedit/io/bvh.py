@@ -210,14 +210,15 @@ def load_bvh(path, scale=None):
     ----------
     path : str or os.PathLike
     scale : float, optional
-        Metres per file unit; guessed from the figure's size at the first frame when
-        omitted (and reported).
+        Metres per file unit; when omitted, guessed from the figure's size over the clip,
+        carrier roots left out, and reported (NOT SURE when no unit makes it a human's).
 
     Returns
     -------
     Rig
         ``vertices`` (0, 3), ``faces`` (0, 3); ``clips`` ``{"take": Clip}`` unless the file
-        has no frames; ``notes`` with ``units`` and ``frames``.
+        has no frames; ``notes`` with ``units`` and ``frames``, and ``carrier`` when the
+        skeleton has carrier roots (they are ``deform=False``).
     """
     path = Path(path)
     data = parse_bvh(path)
