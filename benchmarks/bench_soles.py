@@ -55,9 +55,9 @@ def _passthrough(rig, tgt, rot, hips_pos, mats, *args, **kwargs):
     return rot, hips_pos, mats
 
 
-def measure(res, rig):
+def measure(res, rig, source):
     """Skin measures of one retarget (see the module docstring), in metres."""
-    m = sole_measures(res, rig)
+    m = sole_measures(res, rig, source)
     slips = m["slips"]
     return dict(lowest=m["lowest"], below=m["below"], height=m["standing"],
                 slip=float(slips.mean()) if len(slips) else float("nan"),
@@ -68,11 +68,11 @@ def measure(res, rig):
 def run(source, clip, target):
     """``(before, after, seconds)`` measures of one case."""
     with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
-        before = measure(retarget_result(source, clip, target), target)
+        before = measure(retarget_result(source, clip, target), target, source)
     t0 = time.perf_counter()
     res = retarget_result(source, clip, target)
     dt = time.perf_counter() - t0
-    return before, measure(res, target), dt, len(res.times)
+    return before, measure(res, target, source), dt, len(res.times)
 
 
 def cases(autorig=True):

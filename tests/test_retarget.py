@@ -16,9 +16,9 @@ from rigedit.io.frames import change_axes
 from rigedit.model import Skeleton
 from rigedit.rig import Rig
 from rigedit.rigging import auto_map, retarget_result
-from rigedit.rigging.measure import (direction_errors, foot_slip, lowest_foot,
-                                     target_foot_points)
+from rigedit.rigging.measure import direction_errors
 from rigedit.rigging.name_map import find_slots, normalise_name
+from rigedit.rigging.soles import sole_measures
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"
@@ -133,13 +133,18 @@ def test_bone_directions_agree(src, tgt, results):
 
 @pytest.mark.parametrize("src,tgt", COMBOS, ids=lambda p: Path(str(p)).stem)
 def test_contacts_slip_less_and_feet_above_floor(src, tgt, results):
+    """Measured on the skin (rigedit.rigging.soles, benchmarks/bench_soles.py): the soles
+    never more than 1 mm below the floor, on it within 1 mm where the source's foot stands,
+    slipping under 1 cm per contact. (The joints now follow the skin: a foot rolls and
+    pivots about the patch it stands on, not its ankle, so an ankle's path during a contact
+    is no longer held; CMU 131_01 onto CesiumMan, whose sole lies far from its ankle, moves
+    it 54 mm per contact on average, 43 mm before the clean-up.)"""
     res = results(src, tgt)
+    target = rigedit.load_rig(tgt) if tgt == "humanoid" else _load(tgt)
     assert res.contact.any(axis=0).all(), "every foot point touches the ground at some time"
-    before = foot_slip(target_foot_points(res, res.raw_mats), res.contact).mean()
-    after = foot_slip(target_foot_points(res), res.contact).mean()
-    assert after < 0.2 * before, (before, after)  # measured after / before: 0.000-0.034
-    assert lowest_foot(res) > -1e-3
-    assert lowest_foot(res, res.raw_mats) < lowest_foot(res) or lowest_foot(res) < 0.05
+    skin = sole_measures(res, target)
+    assert skin["lowest"] > -1e-3 and abs(skin["standing"]) < 1e-3, skin
+    assert skin["slips"].max() < 0.01, skin
 
 
 def test_identity_reproduces_source():

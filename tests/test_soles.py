@@ -82,9 +82,9 @@ def _passthrough(rig, tgt, rot, hips_pos, mats, *args, **kwargs):
     return rot, hips_pos, mats
 
 
-def _skin_measures(res, rig):
+def _skin_measures(res, rig, source=None):
     """Lowest sole point over the clip, worst standing height and slip per contact (m)."""
-    m = sole_measures(res, rig)
+    m = sole_measures(res, rig, source)
     return m["lowest"], abs(m["standing"]), float(m["slips"].max(initial=0.0))
 
 
@@ -92,8 +92,8 @@ def _skin_measures(res, rig):
 def test_deep_heels_stay_on_the_floor(humanoid, clip):
     target = deep_heels(humanoid)
     with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
-        before = _skin_measures(retarget_result(humanoid, clip, target), target)
-    after = _skin_measures(retarget_result(humanoid, clip, target), target)
+        before = _skin_measures(retarget_result(humanoid, clip, target), target, humanoid)
+    after = _skin_measures(retarget_result(humanoid, clip, target), target, humanoid)
     if clip == "walk":   # the joints' clean-up alone: the heels through the floor, sliding
         assert before[0] < -0.002 and before[2] > 0.01, before
     assert after[0] > -1e-3, after          # never more than 1 mm below
@@ -107,8 +107,8 @@ def test_bvh_walk_onto_box_feet(humanoid):
     src = rigedit.load_rig(BANDAI_WALK)
     target = deep_heels(humanoid)
     with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
-        before = _skin_measures(retarget_result(src, "take", target), target)
-    after = _skin_measures(retarget_result(src, "take", target), target)
+        before = _skin_measures(retarget_result(src, "take", target), target, src)
+    after = _skin_measures(retarget_result(src, "take", target), target, src)
     assert before[0] < -0.005 or before[1] > 0.005, before
     assert after[0] > -1e-3 and after[1] < 1e-3 and after[2] < 0.01, after
 
@@ -130,8 +130,8 @@ def test_quadruped_hooves_on_the_floor(quadruped):
                                             f"{end}_cannon_{side}": 0.5})
     target = box_feet_rig(sk, boxes, "box hooves")
     with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
-        before = _skin_measures(retarget_result(quadruped, "walk", target), target)
-    after = _skin_measures(retarget_result(quadruped, "walk", target), target)
+        before = _skin_measures(retarget_result(quadruped, "walk", target), target, quadruped)
+    after = _skin_measures(retarget_result(quadruped, "walk", target), target, quadruped)
     assert before[0] < -0.005 or before[1] > 0.005 or before[2] > 0.01, before
     assert after[0] > -1e-3 and after[1] < 1e-3 and after[2] < 0.01, after
 

@@ -35,9 +35,10 @@ from .bake import assemble
 from .contacts import blend_frames, ramp, runs, smooth_max, solve_legs
 
 __all__ = ["Soles", "find_soles", "skin_points", "vertex_heights", "sole_heights",
-           "bearing_steps", "sole_slip", "hold_offsets", "source_clearance", "foot_legs",
+           "bearing_steps", "sole_slip", "hold_offsets", "fade_runs", "source_clearance",
+           "foot_legs",
            "standing_heights", "raise_body", "hold_soles", "sole_measures",
-           "DOMINANT", "TOLERANCE", "STANDING"]
+           "DOMINANT", "TOLERANCE", "STANDING", "PATCH"]
 
 #: A vertex belongs to a foot when at least this much of its weight is on the foot's joints.
 DOMINANT = 0.5
@@ -49,7 +50,10 @@ TOLERANCE = 1e-4
 STANDING = 0.01
 #: Rounds of IK and re-measuring at most: the skin moves with the ankle but for the vertices
 #: the shin shares, and a hips drop moves the other foot.
-ROUNDS = 6
+ROUNDS = 8
+#: The patch a foot stands on: its vertices within this share of the foot's size of its
+#: lowest (4 mm on a 27 cm foot).
+PATCH = 0.015
 
 
 @dataclass
@@ -70,6 +74,8 @@ class Soles:
         foot: its skinned position is ``sum_u K_u[:3] (w_u [v, 1])``.
     floor : float
         Model y of the lowest sole point in the calibration pose.
+    size : float
+        The largest extent of the first foot's vertices in that pose.
     """
 
     joints: list
@@ -77,6 +83,7 @@ class Soles:
     used: np.ndarray
     lifted: np.ndarray
     floor: float = 0.0
+    size: float = 1.0
 
     @property
     def offsets(self):
@@ -125,7 +132,9 @@ def find_soles(rig, feet, calibration_mats, what="target"):
     rest = np.c_[binding.rest_vertices[allv], np.ones(len(allv))]
     lifted = (w[:, :, None] * rest[:, None, :]).reshape(len(allv), 4 * len(used))
     soles = Soles(joints, vertices, used, lifted)
-    soles.floor = float(sole_heights(soles, sk, calibration_mats[None]).min())
+    rest_pts = skin_points(soles, sk, calibration_mats[None])[0]
+    soles.floor = float(rest_pts[:, 1].min())
+    soles.size = float(np.ptp(rest_pts[:len(vertices[0])], axis=0).max()) or 1.0
     return soles
 
 
@@ -157,30 +166,47 @@ def sole_heights(soles, skeleton, mats, heights=None):
     return np.stack([y[:, a:b].min(axis=1) for a, b in zip(off[:-1], off[1:])], axis=1)
 
 
-def bearing_steps(soles, skeleton, mats, heights=None):
-    """How the point each foot stands on moves: per foot, the horizontal (x, z) step from
-    frame ``f`` to ``f + 1`` of the vertex lowest in frame ``f`` (the one bearing the
-    weight).
+def bearing_steps(soles, skeleton, mats, heights=None, patch=None):
+    """How the patch each foot stands on moves: per foot, the horizontal (x, z) step from
+    frame ``f`` to ``f + 1`` of the vertices lowest in frame ``f`` (within ``patch`` of the
+    lowest: the heel at a heel strike, the whole sole of a flat foot, the ball at a push-off),
+    on average.
+
+    Parameters
+    ----------
+    soles : Soles
+    skeleton : Skeleton
+    mats : (F, J, 4, 4) float64
+    heights : (F, N) float64, optional
+        :func:`vertex_heights` of ``mats``.
+    patch : float, optional
+        Model units; by default :data:`PATCH` of the feet's size (the largest extent of the
+        first foot's vertices in the rest pose, so a flat sole's millimetres of wobble do
+        not make its one lowest vertex jump from heel to toe).
 
     Returns
     -------
     steps : (F - 1, n_feet, 2) float64
     """
     y = vertex_heights(soles, skeleton, mats) if heights is None else heights
+    if patch is None:
+        patch = PATCH * soles.size
     off = soles.offsets
     pal = _palette(soles, skeleton, mats)[:, :, [0, 2], :]        # (F, U, 2, 4)
     pal = pal.transpose(0, 1, 3, 2).reshape(len(mats), -1, 2)     # (F, 4U, 2)
     out = np.zeros((max(len(mats) - 1, 0), len(off) - 1, 2))
     for i, (a, b) in enumerate(zip(off[:-1], off[1:])):
-        low = a + np.argmin(y[:-1, a:b], axis=1)
-        z = soles.lifted[low]                                    # (F - 1, 4U)
+        ya = y[:-1, a:b]
+        near = (ya <= ya.min(axis=1, keepdims=True) + patch).astype(np.float64)
+        # the patch's mean lifted vector: its mean position is linear in it
+        z = (near @ soles.lifted[a:b]) / near.sum(axis=1, keepdims=True)
         out[:, i] = (np.einsum("fk,fkc->fc", z, pal[1:])
                      - np.einsum("fk,fkc->fc", z, pal[:-1]))
     return out
 
 
 def sole_slip(steps, contact):
-    """Slip of a foot's skin during each of its contacts: the horizontal path of the point
+    """Slip of a foot's skin during each of its contacts: the horizontal path of the patch
     bearing the weight (:func:`bearing_steps`), summed over each contact's frames. A foot
     rolling from heel to toe turns about its lowest point and does not slip; one sliding, or
     turning about its ankle, does.
@@ -203,7 +229,7 @@ def sole_slip(steps, contact):
 def hold_offsets(steps, contact, blend):
     """Horizontal offsets that stop a foot's skin slipping during its contacts.
 
-    In each contact the foot is moved so that the vertex bearing the weight in a frame
+    In each contact the foot is moved so that the patch bearing the weight in a frame
     stays where it is in the next (the foot turns about the point it stands on: a heel
     strike rolls onto the ball, a pivot turns about it); the offsets are centred on the
     contact (the foot stands where it stood on average) and faded in before it and out after
@@ -222,26 +248,36 @@ def hold_offsets(steps, contact, blend):
     offsets : (F, 2) float64
         To add to the foot's x and z.
     """
-    n = len(contact)
-    out = np.zeros((n, 2))
-    best = np.zeros(n)
+    held = np.zeros((len(contact), 2))
     for a, b in runs(contact):
-        held = np.zeros((b - a, 2))
-        held[1:] = -np.cumsum(steps[a:b - 1], axis=0)
-        held -= held.mean(axis=0)
-        out[a:b], best[a:b] = held, 1.0
+        held[a + 1:b] = -np.cumsum(steps[a:b - 1], axis=0)
+        held[a:b] -= held[a:b].mean(axis=0)
+    return fade_runs(held, contact, blend)
+
+
+def fade_runs(values, mask, blend):
+    """``values`` (F, ...) inside the runs of the (F,) bool ``mask``, 0 elsewhere but for the
+    ``blend`` frames either side of a run, which take the run's edge value faded by
+    :func:`rigedit.rigging.contacts.ramp`'s weight (the nearer run's where two meet)."""
+    n = len(mask)
+    out = np.zeros_like(values)
+    best = np.zeros(n)
+    for a, b in runs(mask):
+        out[a:b], best[a:b] = values[a:b], 1.0
         for k in range(1, blend + 1):
             w = 1.0 - k / (blend + 1)
-            for f, edge in ((a - k, 0), (b - 1 + k, -1)):
+            for f, edge in ((a - k, a), (b - 1 + k, b - 1)):
                 if 0 <= f < n and w > best[f]:
-                    best[f], out[f] = w, w * held[edge]
+                    best[f], out[f] = w, w * values[edge]
     return out
 
 
-def source_clearance(src, smats, s_floor, s_points, scale):
-    """How high the source's contact points stand above where they stand standing, scaled
-    to the target: ``scale (y_p(t) - s_floor - y_p(rest))``, the height
-    :func:`rigedit.rigging.contacts.detect_contacts` compares with its tolerance.
+def source_clearance(src, smats, s_floor, s_points, scale, source_rig=None):
+    """How high the source's feet stand above where they stand standing, scaled to the
+    target: on the source's skin when it has one (each foot's lowest skinned point above
+    the floor its rest soles define, moved as the motion's floor is), else on its contact
+    joints (``y_p(t) - s_floor - y_p(rest)``, the height
+    :func:`rigedit.rigging.contacts.detect_contacts` compares with its tolerance).
 
     Parameters
     ----------
@@ -251,16 +287,35 @@ def source_clearance(src, smats, s_floor, s_points, scale):
     s_floor : float
         The motion's floor (model y).
     s_points : list of int
-        The source joint of each column of the retarget's contacts.
+        The source joint of each column of the retarget's contacts (a humanoid's left and
+        right ankle and toe; else the source foot leaf of each target leg).
     scale : float
         Target / source hip height.
+    source_rig : Rig, optional
+        The source; its skin is used when it has a mesh that weights the feet.
 
     Returns
     -------
     clearance : (F, P) float64
     """
     rest = src.mats[s_points, 1, 3] - src.joint_floor
-    return scale * (smats[:, s_points, 1, 3] - s_floor - rest[None])
+    joints = scale * (smats[:, s_points, 1, 3] - s_floor - rest[None])
+    if source_rig is None or len(source_rig.vertices) == 0:
+        return joints
+    if src.kind == "humanoid":
+        ankles = [src.slots["foot_L"], src.slots["foot_R"]] * 2
+    else:
+        by_leaf = {leg.contact: leg.ankle for leg in src.legs}
+        ankles = [by_leaf.get(p, p) for p in s_points]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a source without skinned feet: its joints say
+        soles = find_soles(source_rig, sorted(set(ankles)), src.mats)
+    if soles is None:
+        return joints
+    col = {a: i for i, a in enumerate(sorted(set(ankles)))}
+    low = sole_heights(soles, source_rig.skeleton, smats) - soles.floor \
+        - (s_floor - src.joint_floor)
+    return scale * low[:, [col[a] for a in ankles]]
 
 
 def foot_legs(tgt, contact, clearance=None):
@@ -325,6 +380,13 @@ def standing_heights(clearance, contact, blend, tol):
     return np.maximum(0.0, clearance - np.nan_to_num(base) - tol)
 
 
+def _onto_floor(low, held, blend):
+    """(F, n_feet) the height change that puts each sole on the floor where its foot stands
+    (``held``), faded out before and after (:func:`fade_runs`)."""
+    return np.stack([fade_runs(-low[:, i], held[:, i], blend) for i in range(low.shape[1])],
+                    axis=1)
+
+
 def raise_body(weights, change, blend):
     """How far to raise (or lower) the body so that the feet on the ground move as they must
     without bending the legs: in each frame where every foot on the ground (weight above 0)
@@ -353,6 +415,17 @@ def raise_body(weights, change, blend):
         return need
     kernel = np.ones(2 * blend + 1) / (2 * blend + 1)
     return np.convolve(np.pad(need, blend, mode="edge"), kernel, mode="valid")
+
+
+def _move_feet(sk, tgt, rot, hips_pos, mats, legs, move, blend, mapped):
+    """Each leg's ankle moved by ``move`` (F, n_feet, 3) by two-bone IK (the hips dropping
+    where a leg cannot reach); returns ``rot``, ``hips_pos``, ``mats``."""
+    solve = [(upper, knee, mats[:, ankle, :3, 3], mats[:, ankle, :3, 3] + move[:, i])
+             for i, (upper, knee, ankle) in enumerate(legs)]
+    rot, drop = solve_legs(sk, tgt, rot, mats, solve, blend, mapped)
+    hips_pos = hips_pos.copy()
+    hips_pos[:, 1] -= drop
+    return rot, hips_pos, assemble(sk, rot, tgt.hips, hips_pos)
 
 
 def hold_soles(rig, tgt, rot, hips_pos, mats, contact, clearance, times, mapped,
@@ -396,47 +469,56 @@ def hold_soles(rig, tgt, rot, hips_pos, mats, contact, clearance, times, mapped,
     if soles is None:
         return rot, hips_pos, mats
     blend = blend_frames(times)
-    w = np.stack([ramp(touch[:, i], blend) for i in range(len(legs))], axis=1)
     tol = TOLERANCE * tgt.hip_height
     stand = np.stack([standing_heights(clear[:, i], touch[:, i], blend,
                                        STANDING * tgt.hip_height)
                       for i in range(len(legs))], axis=1)
+    # the frames a foot stands in: contacts, less those in which the source lifts it
+    held = touch & (stand == 0)
+    w = np.stack([ramp(held[:, i], blend) for i in range(len(legs))], axis=1)
     rot, hips_pos = rot.copy(), np.array(hips_pos, dtype=np.float64)
     y = vertex_heights(soles, sk, mats)
     low = sole_heights(soles, sk, mats, y) - soles.floor
     # where every foot on the ground sinks (the joints stand where they should but the skin
     # reaches lower than they say), the body rises, where every one floats it sinks: the
     # legs keep the source's directions
-    raise_by = raise_body(w, stand - low, blend)
+    onto = _onto_floor(low, held, blend)
+    raise_by = raise_body(w, onto, blend)
     if raise_by.any():
         hips_pos[:, 1] += raise_by
         mats = assemble(sk, rot, tgt.hips, hips_pos)
         y = vertex_heights(soles, sk, mats)
         low = sole_heights(soles, sk, mats, y) - soles.floor
-    # outside contacts only lift (spread over the fade so a swing does not kink); inside them
-    # the sole stands where the source's does; in the fade between, a blend, never below
-    lift = np.where(w >= 1.0, 0.0, np.maximum(0.0, -low))
+    # standing, the sole goes onto the floor, the change faded out before and after as the
+    # joints' pins are; elsewhere a sole below the floor is lifted (the lift spread over the
+    # fade's width so a swing does not kink)
+    onto = _onto_floor(low, held, blend)
+    lift = np.where(held, 0.0, np.maximum(0.0, -(low + onto)))
     lift = np.stack([smooth_max(c, blend) if c.any() else c for c in lift.T], axis=1)
-    goal = w * stand + (1 - w) * (low + lift)
+    goal = low + onto + np.where(held, 0.0, lift)
     # the skin does not slide while it stands (the joints' pins hold the ankle and toe, but
-    # a foot turning about its ankle still slides its sole); a foot the source lifts is free
-    held = touch & (stand == 0)
+    # a foot turning about its ankle still slides its sole)
     gain = np.ones_like(low)
+    zero = np.zeros((len(times), len(legs)))
     for _ in range(ROUNDS):
         steps = bearing_steps(soles, sk, mats, y)
         across = np.stack([hold_offsets(steps[:, i], held[:, i], blend)
                            for i in range(len(legs))], axis=1)
-        if max(np.abs(goal - low).max(), np.abs(across).max()) <= tol:
+        slide = np.abs(across).max() > tol
+        if slide:  # across first, so that the heights' gain below measures heights alone
+            move = np.stack([across[..., 0], zero, across[..., 1]], axis=-1)
+            rot, hips_pos, mats = _move_feet(sk, tgt, rot, hips_pos, mats, legs, move,
+                                             blend, mapped)
+            y = vertex_heights(soles, sk, mats)
+            low = sole_heights(soles, sk, mats, y) - soles.floor
+        if np.abs(goal - low).max() <= tol:
+            if slide:
+                continue
             break
         change = (goal - low) / gain
-        solve = []
-        for i, (upper, knee, ankle) in enumerate(legs):
-            at = mats[:, ankle, :3, 3]
-            move = np.c_[across[:, i, 0], change[:, i], across[:, i, 1]]
-            solve.append((upper, knee, at, at + move))
-        rot, drop = solve_legs(sk, tgt, rot, mats, solve, blend, mapped)
-        hips_pos[:, 1] -= drop
-        mats = assemble(sk, rot, tgt.hips, hips_pos)
+        rot, hips_pos, mats = _move_feet(sk, tgt, rot, hips_pos, mats, legs,
+                                         np.stack([zero, change, zero], axis=-1), blend,
+                                         mapped)
         y = vertex_heights(soles, sk, mats)
         before, low = low, sole_heights(soles, sk, mats, y) - soles.floor
         # how far the sole moved per unit the ankle did (under 1 where the knee's bone
@@ -448,7 +530,7 @@ def hold_soles(rig, tgt, rot, hips_pos, mats, contact, clearance, times, mapped,
     return rot, hips_pos, mats
 
 
-def sole_measures(result, rig):
+def sole_measures(result, rig, source_rig=None):
     """How a retarget's feet stand on the skin: the figures of ``benchmarks/bench_soles.py``.
 
     Parameters
@@ -456,6 +538,8 @@ def sole_measures(result, rig):
     result : RetargetResult
         A retarget onto ``rig`` (a rig with a mesh whose feet have vertices).
     rig : Rig
+    source_rig : Rig, optional
+        The retarget's source (its skin says where its feet stand, as in the retarget).
 
     Returns
     -------
@@ -469,7 +553,8 @@ def sole_measures(result, rig):
     """
     tgt = result.target_calibration
     clear = source_clearance(result.source_calibration, result.source_mats,
-                             result.source_floor, result.source_contacts, result.scale)
+                             result.source_floor, result.source_contacts, result.scale,
+                             source_rig)
     legs, touch, clear = foot_legs(tgt, result.contact, clear)
     soles = find_soles(rig, [a for *_, a in legs], tgt.mats)
     y = vertex_heights(soles, rig.skeleton, result.mats)
