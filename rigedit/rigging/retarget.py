@@ -38,7 +38,6 @@ from scipy.spatial.transform import Rotation
 
 from ..animation.clip import Clip
 from .bake import assemble, to_clip
-from .bare import bare_result
 from .calibrate import calibrate, model_stack
 from .contacts import clean_feet as hold_feet, clean_legs, detect_contacts
 from .facing import clip_forward, face_by_hips, facing_doubt, heading_degrees
@@ -161,15 +160,8 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
     if isinstance(source_clip, str):
         source_clip = source_rig.clips[source_clip]
     ssk, tsk = source_rig.skeleton, target_rig.skeleton
-    try:
-        src, tgt = _calibrate_pair(ssk, [source_clip], tsk, list(target_rig.clips.values()),
-                                   source_what, target_what)
-    except ValueError as exc:  # no legs found: two rigs of one family still map by name
-        fields = bare_result(source_rig, source_clip, target_rig, map, name,
-                             _sample_times(source_clip), source_what, target_what, str(exc))
-        if fields is None:
-            raise
-        return RetargetResult(**fields)
+    src, tgt = _calibrate_pair(ssk, [source_clip], tsk, list(target_rig.clips.values()),
+                               source_what, target_what)
     humanoid = src.kind == "humanoid"
     if map is None:
         map = auto_map(ssk, src.points, tsk, tgt.points, source_what, target_what) \
