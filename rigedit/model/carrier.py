@@ -27,8 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["carrier_joints", "carrier_note", "figure_points", "figure_root", "FLOOR",
-           "CLIMB", "MARGIN", "MAX_CHAIN"]
+__all__ = ["carrier_joints", "carrier_note", "figure_root", "FLOOR", "CLIMB", "MARGIN",
+           "MAX_CHAIN"]
 
 #: A carrier "at the floor": within this fraction of the figure's height of its lowest joint.
 FLOOR = 0.05
@@ -131,29 +131,6 @@ def figure_root(parents, carriers):
         if not carriers[j] and (p < 0 or carriers[p]):
             return j
     return 0
-
-
-def figure_points(parents, points, carriers):
-    """``points`` with each carrier moved onto the figure's root below it: same shape, so
-    that every measure of extent, size or facing sees the figure alone.
-
-    Parameters
-    ----------
-    parents : (J,) int
-    points : (..., J, 3) float
-    carriers : (J,) bool
-
-    Returns
-    -------
-    points : (..., J, 3) float64, a copy
-    """
-    out = np.array(points, dtype=np.float64)
-    parents = np.asarray(parents)
-    kids = _children(parents)
-    for c in reversed(np.flatnonzero(carriers)):  # the deepest carrier first
-        below = kids[c][0]
-        out[..., c, :] = out[..., below, :]
-    return out
 
 
 def carrier_note(names, parents, points, carriers, scale=1.0, unit="m"):
