@@ -194,6 +194,7 @@ def variants(full):
         out.update({f"heat, c={c:g}": ("heat", {"c": c}) for c in (1.0, 2.0, 3.0, 8.0)})
         out.update({
             "heat, helpers kept": ("heat", {"helpers": False}),
+            "heat, every part blocks": ("heat", {"own_part": False}),
             "heat, branch centroid": ("heat", {"branches": "centroid"}),
             "heat, leaf tails off": ("heat", {"infer_tails": False}),
             "heat, front-facing rule": ("heat", {"front_only": True}),

@@ -91,3 +91,57 @@ def test_the_end_rings_of_a_coarse_tapered_cylinder_see_their_bone():
     w = heat(v, sk, f)
     bottom, top = v[:, 2] < -4, v[:, 2] > 4
     assert w[bottom, 0].min() > 0.98 and w[top, 1].min() > 0.98
+
+
+def sphere(centre, radius, n=12):
+    """A closed UV sphere: (V, 3) vertices, (F, 3) faces wound outward."""
+    th = np.linspace(0, np.pi, n + 1)[1:-1]
+    ph = np.linspace(0, 2 * np.pi, 2 * n, endpoint=False)
+    t, p = np.meshgrid(th, ph, indexing="ij")
+    v = np.stack([np.sin(t) * np.cos(p), np.cos(t), np.sin(t) * np.sin(p)], -1).reshape(-1, 3)
+    v = np.concatenate([[[0, 1, 0]], v, [[0, -1, 0]]]) * radius + centre
+    m = 2 * n
+    f = []
+    for s in range(m):
+        f.append((0, 1 + (s + 1) % m, 1 + s))
+        last = 1 + (n - 2) * m
+        f.append((len(v) - 1, last + s, last + (s + 1) % m))
+    for r in range(n - 2):
+        for s in range(m):
+            a, b = 1 + r * m + s, 1 + r * m + (s + 1) % m
+            f += [(a, b, b + m), (a, b + m, a + m)]
+    return v, np.array(f)
+
+
+def test_a_separate_part_overlapping_the_body_does_not_hide_its_bones():
+    # Mixamo's Xbot is a body and separate joint pieces through its skin at the shoulders,
+    # elbows and knees (one mesh after loading). Segments from the body's skin to its
+    # bones crossed the pieces: the skin around them saw no bone and took heat from
+    # farther bones. Each part now tests only its own triangles, as Blender does per object.
+    body, bf = cylinder(radius=0.3, height=3.0, rings=31)
+    ball, sf = sphere([0.3, 1.55, 0.01], 0.2)
+    v = np.concatenate([body, ball])
+    f = np.concatenate([bf, sf + len(body)])
+    sk = skeleton(["a", "b"], [-1, 0], [[0, 0.0, 0], [0, 1.5, 0]], [[np.nan] * 3, [0, 3, 0]])
+    alone = heat(body, sk, bf)
+    w = heat(v, sk, f)[:len(body)]
+    np.testing.assert_allclose(w, alone, atol=1e-9)
+    hidden = heat(v, sk, f, own_part=False)[:len(body)]   # the old rule
+    assert np.abs(hidden - alone).max() > 0.05
+
+
+def test_part_filtered_rays_agree_between_kernels():
+    from rigedit.model.visibility import HAVE_NUMBA, SurfaceRays
+    if not HAVE_NUMBA:
+        return
+    ball, sf = sphere([0, 0, 0], 1.0)
+    v = np.concatenate([ball, ball * 0.5])
+    f = np.concatenate([sf, sf + len(ball)])
+    parts = np.r_[np.zeros(len(sf), int), np.ones(len(sf), int)]
+    rng = np.random.default_rng(1)
+    o, e = rng.normal(size=(300, 3)), rng.normal(size=(300, 3)) * 0.1
+    part = rng.integers(-1, 2, 300)
+    a = SurfaceRays(v, f, parts=parts).first_hit(o, e, part=part)
+    b = SurfaceRays(v, f, parts=parts, use_numba=False).first_hit(o, e, part=part)
+    np.testing.assert_allclose(a, b)
+    assert np.isfinite(a).sum() > 100 and (a != SurfaceRays(v, f).first_hit(o, e)).any()

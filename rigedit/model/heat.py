@@ -178,7 +178,7 @@ def _factor_solve(A, B, solver="auto"):
 def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None,
                  c=C_HEAT, min_weight=MIN_WEIGHT, front_only=False, normal_bias=False,
                  behind=BEHIND, infer_tails=True, operator="cotan", solver="auto",
-                 use_numba=None, branches="children", helpers=True):
+                 use_numba=None, branches="children", helpers=True, own_part=True):
     """Bone-heat weights of a triangle mesh (see the module notes).
 
     Parameters
@@ -260,7 +260,7 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
     report(0.1)
 
     t0 = time.perf_counter()
-    rays = SurfaceRays(wv, wf, use_numba=use_numba)
+    rays = SurfaceRays(wv, wf, use_numba=use_numba, parts=label[wf[:, 0]])
     normals = lap.vertex_normals(wv, wf, label)
     deform = deforming_joints(skeleton, wv, normals, helpers=helpers)
     tails = skeleton.tails
@@ -295,7 +295,7 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
 
     def test(verts, cols):
         return _visible(wv, normals, ring, verts, cols, seg, starts, ends, rays, front_only,
-                        behind, 1e-4 * diag)
+                        behind, 1e-4 * diag, label if own_part else None)
     pairs_v, pairs_j, best = _visible_nearest(wv, rank, dist, seg, starts, ends, report, test)
     timings["visibility"] = time.perf_counter() - t0
 
@@ -412,7 +412,7 @@ def _visible_nearest(wv, rank, dist, seg, starts, ends, report, test):
 
 
 def _visible(wv, normals, ring, verts, joints, seg, starts, ends, rays, front_only, behind,
-             offset):
+             offset, label=None):
     """(N,) bool: joint ``joints[n]`` is visible from vertex ``verts[n]``: the segment to
     its nearest point crosses no triangle, and that point lies behind the vertex's surface:
     ``cos(normal, to bone) < behind``, and behind (or in) the planes of the vertex's own
@@ -442,7 +442,8 @@ def _visible(wv, normals, ring, verts, joints, seg, starts, ends, rays, front_on
     start = wv[verts[ok]] + offset * step
     test = ok & ~on
     ok[test] = ~rays.blocked(start[~on[ok]], target[test], t_lo=0.0, t_hi=1.0 - 1e-4,
-                             front_only=front_only)
+                             front_only=front_only,
+                             part=None if label is None else label[verts[test]])
     return ok
 
 

@@ -79,21 +79,21 @@ def _build_py(tri_lo, tri_hi, leaf):
     return lo[:count], hi[:count], left[:count], bmin[:count], bmax[:count]
 
 
-def _first_hit_py(orig, end, skip, tv, p0, e1, e2, lo, hi, left, bmin, bmax, t_lo, t_hi,
-                  front, any_hit, out):
+def _first_hit_py(orig, end, skip, rpart, tv, tpart, p0, e1, e2, lo, hi, left, bmin, bmax,
+                  t_lo, t_hi, front, any_hit, out):
     """Loop kernel of :meth:`SurfaceRays.first_hit` (numba-compiled when available).
 
     Rays go in blocks of ``BLOCK``, one traversal stack per block.
     """
     nblocks = (orig.shape[0] + BLOCK - 1) // BLOCK
     for blk in range(nblocks):
-        _block(blk * BLOCK, min(orig.shape[0], (blk + 1) * BLOCK), orig, end, skip, tv, p0,
-               e1, e2, lo, hi, left, bmin, bmax, t_lo, t_hi, front, any_hit, out)
+        _block(blk * BLOCK, min(orig.shape[0], (blk + 1) * BLOCK), orig, end, skip, rpart, tv,
+               tpart, p0, e1, e2, lo, hi, left, bmin, bmax, t_lo, t_hi, front, any_hit, out)
     return out
 
 
-def _block_py(r0, r1, orig, end, skip, tv, p0, e1, e2, lo, hi, left, bmin, bmax, t_lo, t_hi,
-              front, any_hit, out):
+def _block_py(r0, r1, orig, end, skip, rpart, tv, tpart, p0, e1, e2, lo, hi, left, bmin, bmax,
+              t_lo, t_hi, front, any_hit, out):
     stack = np.empty(128, np.int64)
     for r in range(r0, r1):
         ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
@@ -102,6 +102,7 @@ def _block_py(r0, r1, orig, end, skip, tv, p0, e1, e2, lo, hi, left, bmin, bmax,
         iy = 1.0 / dy if dy != 0.0 else 1e300
         iz = 1.0 / dz if dz != 0.0 else 1e300
         s = skip[r]
+        rp = rpart[r]
         best = np.inf
         stack[0] = 0
         top = 1
@@ -130,6 +131,8 @@ def _block_py(r0, r1, orig, end, skip, tv, p0, e1, e2, lo, hi, left, bmin, bmax,
                 continue
             for m in range(lo[k], hi[k]):
                 if tv[m, 0] == s or tv[m, 1] == s or tv[m, 2] == s:
+                    continue
+                if rp >= 0 and tpart[m] != rp:
                     continue
                 # Moller-Trumbore; det > 0 when the segment enters the triangle's front side
                 px = dy * e2[m, 2] - dz * e2[m, 1]
@@ -169,12 +172,13 @@ else:  # pragma: no cover
     _first_hit = None
 
 
-def _first_hit_numpy(orig, end, skip, tv, p0, e1, e2, radius, tree, t_lo, t_hi, front,
-                     chunk=2048):
+def _first_hit_numpy(orig, end, skip, rpart, tv, tpart, p0, e1, e2, radius, tree, t_lo, t_hi,
+                     front, chunk=2048):
     """Vectorised reference: candidate triangles by a ball around each segment."""
     out = np.full(len(orig), np.inf)
     for a in range(0, len(orig), chunk):
         o, e, s = orig[a:a + chunk], end[a:a + chunk], skip[a:a + chunk]
+        rp = rpart[a:a + chunk]
         mid = 0.5 * (o + e)
         reach = 0.5 * np.linalg.norm(e - o, axis=1) + radius
         lists = tree.query_ball_point(mid, reach)
@@ -183,7 +187,7 @@ def _first_hit_numpy(orig, end, skip, tv, p0, e1, e2, radius, tree, t_lo, t_hi, 
             continue
         r = np.repeat(np.arange(len(o)), counts)
         m = np.concatenate([np.asarray(x, dtype=np.int64) for x in lists])
-        keep = np.all(tv[m] != s[r][:, None], axis=1)
+        keep = np.all(tv[m] != s[r][:, None], axis=1) & ((rp[r] < 0) | (tpart[m] == rp[r]))
         r, m = r[keep], m[keep]
         d = e[r] - o[r]
         p = np.cross(d, e2[m])
@@ -209,9 +213,12 @@ class SurfaceRays:
     faces : (F, 3) int64
     use_numba : bool, optional
         Force the compiled (True) or numpy (False) path; default: compiled when available.
+    parts : (F,) int, optional
+        A part id per triangle, for segments that only test the triangles of their own part
+        (``first_hit(..., part=...)``).
     """
 
-    def __init__(self, vertices, faces, use_numba=None):
+    def __init__(self, vertices, faces, use_numba=None, parts=None):
         vertices = np.ascontiguousarray(vertices, dtype=np.float64)
         faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
         self.use_numba = HAVE_NUMBA if use_numba is None else (use_numba and HAVE_NUMBA)
@@ -222,6 +229,8 @@ class SurfaceRays:
         order = _morton_order(corners.mean(axis=1))
         corners = corners[order]
         self.tv = np.ascontiguousarray(faces[order])
+        self.tpart = (np.zeros(len(faces), np.int64) if parts is None
+                      else np.ascontiguousarray(np.asarray(parts, np.int64)[order]))
         self.p0 = np.ascontiguousarray(corners[:, 0])
         self.e1 = np.ascontiguousarray(corners[:, 1] - corners[:, 0])
         self.e2 = np.ascontiguousarray(corners[:, 2] - corners[:, 0])
@@ -235,7 +244,7 @@ class SurfaceRays:
             self.centre = centre
 
     def first_hit(self, origins, ends, skip=None, t_lo=0.0, t_hi=1.0, front_only=False,
-                  any_hit=False):
+                  any_hit=False, part=None):
         """Where each segment first crosses the surface.
 
         Parameters
@@ -249,6 +258,9 @@ class SurfaceRays:
             Count only crossings that enter a triangle from its front (normal) side.
         any_hit : bool
             Stop at the first crossing found rather than the nearest (for a yes/no test).
+        part : (N,) int, optional
+            Test only the triangles of this part (the ``parts`` given at construction) for
+            each segment; -1 or omitted: every triangle.
 
         Returns
         -------
@@ -261,18 +273,23 @@ class SurfaceRays:
                 else np.ascontiguousarray(skip, dtype=np.int64))
         if self.empty or len(origins) == 0:
             return np.full(len(origins), np.inf)
+        part = (np.full(len(origins), -1, np.int64) if part is None
+                else np.ascontiguousarray(part, dtype=np.int64))
         if self.use_numba:
             out = np.empty(len(origins))
-            return _first_hit(origins, ends, skip, self.tv, self.p0, self.e1, self.e2,
-                              *self.nodes[:3], *self.nodes[3:], float(t_lo), float(t_hi),
-                              bool(front_only), bool(any_hit), out)
-        return _first_hit_numpy(origins, ends, skip, self.tv, self.p0, self.e1, self.e2,
-                                self.radius, self.tree, t_lo, t_hi, front_only)
+            return _first_hit(origins, ends, skip, part, self.tv, self.tpart, self.p0, self.e1,
+                              self.e2, *self.nodes[:3], *self.nodes[3:], float(t_lo),
+                              float(t_hi), bool(front_only), bool(any_hit), out)
+        return _first_hit_numpy(origins, ends, skip, part, self.tv, self.tpart, self.p0,
+                                self.e1, self.e2, self.radius, self.tree, t_lo, t_hi,
+                                front_only)
 
-    def blocked(self, origins, ends, skip=None, t_lo=0.0, t_hi=1.0, front_only=False):
-        """(N,) bool: the segment crosses the surface strictly between ``t_lo`` and ``t_hi``."""
+    def blocked(self, origins, ends, skip=None, t_lo=0.0, t_hi=1.0, front_only=False,
+                part=None):
+        """(N,) bool: the segment crosses the surface strictly between ``t_lo`` and ``t_hi``
+        (only the triangles of its ``part`` when given, as for :meth:`first_hit`)."""
         return np.isfinite(self.first_hit(origins, ends, skip, t_lo, t_hi, front_only,
-                                          any_hit=True))
+                                          any_hit=True, part=part))
 
 
 def warm():
