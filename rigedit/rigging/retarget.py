@@ -38,6 +38,7 @@ from scipy.spatial.transform import Rotation
 
 from ..animation.clip import Clip
 from .bake import assemble, to_clip
+from .bare import bare_result
 from .calibrate import calibrate, model_stack
 from .contacts import clean_feet as hold_feet, clean_legs, detect_contacts
 from .facing import clip_forward, face_by_hips, facing_doubt, heading_degrees
@@ -160,8 +161,15 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
     if isinstance(source_clip, str):
         source_clip = source_rig.clips[source_clip]
     ssk, tsk = source_rig.skeleton, target_rig.skeleton
-    src, tgt = _calibrate_pair(ssk, [source_clip], tsk, list(target_rig.clips.values()),
-                               source_what, target_what)
+    try:
+        src, tgt = _calibrate_pair(ssk, [source_clip], tsk, list(target_rig.clips.values()),
+                                   source_what, target_what)
+    except ValueError as exc:  # no legs found: two rigs of one family still map by name
+        fields = bare_result(source_rig, source_clip, target_rig, map, name,
+                             _sample_times(source_clip), source_what, target_what, str(exc))
+        if fields is None:
+            raise
+        return RetargetResult(**fields)
     humanoid = src.kind == "humanoid"
     if map is None:
         map = auto_map(ssk, src.points, tsk, tgt.points, source_what, target_what) \
@@ -218,7 +226,7 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
         hips_t = hips_t - np.c_[np.zeros_like(drop), drop, np.zeros_like(drop)]
         mats = assemble(tsk, rot, hips, hips_t)
         # what the user sees is the skin: its soles on the floor, not only the joints
-        clear = source_clearance(src, smats, s_floor, s_points, scale, source_rig)
+        clear = source_clearance(src, smats, s_floor, s_points, scale)
         rot, hips_t, mats = hold_soles(target_rig, tgt, rot, hips_t, mats, contact, clear,
                                        times, inverse, target_what)
     clip = to_clip(tsk, mats, rot, times, name or source_clip.name, source_clip, hips,
