@@ -226,7 +226,7 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
         hips_t = hips_t - np.c_[np.zeros_like(drop), drop, np.zeros_like(drop)]
         mats = assemble(tsk, rot, hips, hips_t)
         # what the user sees is the skin: its soles on the floor, not only the joints
-        clear = source_clearance(src, smats, s_floor, s_points, scale)
+        clear = source_clearance(src, smats, s_floor, s_points, scale, source_rig)
         rot, hips_t, mats = hold_soles(target_rig, tgt, rot, hips_t, mats, contact, clear,
                                        times, inverse, target_what)
     clip = to_clip(tsk, mats, rot, times, name or source_clip.name, source_clip, hips,
