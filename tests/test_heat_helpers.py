@@ -49,6 +49,9 @@ def test_a_carrier_root_on_the_ground_with_several_children_takes_no_weight():
                   [nan, nan, nan, [0, 3.1, 0], nan, nan])
     w = heat(v, sk, f)
     assert w[:, 0].max() == 0.0                       # the carrier
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", HeatWeightsWarning)
+        assert heat_weights(v, sk, f).left_out == {"root": "carrier root"}
     low = v[:, 1] < 0.5
     assert w[low, 1].min() > 0.9                      # the body's bottom is the body's
     before = heat(v, sk, f, helpers=False)            # the old rule: one child only

@@ -33,6 +33,7 @@ import scipy.sparse as sp
 
 from . import laplacian as lap
 from .skinning import top_k_influences
+from .helper_joints import helper_joints
 from .tails import branch_tails, deforming_joints, infer_leaf_tails
 from .visibility import SurfaceRays
 from .weights import inverse_distance_weights, point_segment_distance
@@ -78,6 +79,9 @@ class WeightsResult(tuple):
         The bone tails used (inferred for leaves), NaN for joints with none.
     deform : (J,) bool
         The joints that could take weight.
+    left_out : dict[str, str]
+        Joints flagged deforming that took no weight, and why (an end marker, an IK or pole
+        target, a twist or share bone, a carrier root, zero length).
     """
 
     def __new__(cls, indices, weights, **info):
@@ -86,6 +90,7 @@ class WeightsResult(tuple):
         self.timings = info.get("timings", {})
         self.tails = info.get("tails")
         self.deform = info.get("deform")
+        self.left_out = info.get("left_out", {})
         return self
 
 
@@ -356,7 +361,14 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
                       f"bones", HeatWeightsWarning, stacklevel=2)
     report(1.0)
     return WeightsResult(out_idx, out_w, fallback=fallback, timings=timings, tails=tails,
-                         deform=deform)
+                         deform=deform, left_out=_left_out(skeleton, deform))
+
+
+def _left_out(skeleton, deform):
+    """{joint name: why} for the joints flagged deforming that take no weight."""
+    reasons = helper_joints(skeleton.names, skeleton.parents, skeleton.bind_matrices[:, :3, 3])
+    return {skeleton.names[j]: reasons[j] or "zero length"
+            for j in np.flatnonzero(skeleton.deform & ~deform)}
 
 
 def _visible_nearest(wv, rank, dist, seg, starts, ends, report, test):
