@@ -260,3 +260,62 @@ def test_cli_warns_of_unmapped_limbs_and_strict_fails(humanoid, tmp_path):
                "-o", tmp_path / "d.json")
     assert res.returncode == 0 and "unmapped (they keep their rest pose): head (Head)" in \
         res.stderr, res.stderr
+
+
+#: The bundled humanoid's joints as other rigs name them (Unreal's mannequin, 3ds Max's
+#: biped, MotionBuilder's HumanIK), each with twist leaves beside the real children.
+NAMINGS = {
+    "unreal": {"root": "root", "Hips": "pelvis", "Spine": "spine_01", "Spine1": "spine_02",
+               "Spine2": "spine_03", "Neck": "neck_01", "Head": "head",
+               "LeftShoulder": "clavicle_l", "LeftArm": "upperarm_l",
+               "LeftForeArm": "lowerarm_l", "LeftHand": "hand_l", "LeftUpLeg": "thigh_l",
+               "LeftLeg": "calf_l", "LeftFoot": "foot_l", "LeftToeBase": "ball_l"},
+    "biped": {"root": "Bip01", "Hips": "Bip01 Pelvis", "Spine": "Bip01 Spine",
+              "Spine1": "Bip01 Spine1", "Spine2": "Bip01 Spine2", "Neck": "Bip01 Neck",
+              "Head": "Bip01 Head", "LeftShoulder": "Bip01 L Clavicle",
+              "LeftArm": "Bip01 L UpperArm", "LeftForeArm": "Bip01 L Forearm",
+              "LeftHand": "Bip01 L Hand", "LeftUpLeg": "Bip01 L Thigh",
+              "LeftLeg": "Bip01 L Calf", "LeftFoot": "Bip01 L Foot",
+              "LeftToeBase": "Bip01 L Toe0"},
+    "humanik": {n: f"Character1_{n}" for n in ("Hips", "Spine", "Spine1", "Spine2", "Neck",
+                                               "Head", "LeftShoulder", "LeftArm",
+                                               "LeftForeArm", "LeftHand", "LeftUpLeg",
+                                               "LeftLeg", "LeftFoot", "LeftToeBase")}
+    | {"root": "Character1_Reference"},
+}
+
+
+def _renamed_with_twists(humanoid, naming):
+    sk = humanoid.skeleton
+    p = _points(sk)
+
+    def rename(n):
+        if n in naming:
+            return naming[n]
+        left = n.replace("Right", "Left")
+        out = naming[left]
+        return (out.replace("_l", "_r") if out.endswith("_l") else
+                out.replace(" L ", " R ").replace("Left", "Right"))
+    joints = []
+    for i, n in enumerate(sk.names):
+        parent = None if sk.parents[i] < 0 else rename(sk.names[sk.parents[i]])
+        joints.append((rename(n), parent, p[i]))
+        if n.endswith(("UpLeg", "Arm")) and "Fore" not in n:
+            # a twist leaf at the limb joint, its first child (before the real one)
+            joints.append((rename(n) + "_twist", rename(n), p[i]))
+    return _from_points(joints)
+
+
+@pytest.mark.parametrize("naming", list(NAMINGS))
+def test_other_rigs_names_map_onto_the_humanoid(humanoid, naming):
+    """Unreal, 3ds Max biped and HumanIK names with twist leaves under the thighs and upper
+    arms: every slot lands on the humanoid's joint of the same role."""
+    names = NAMINGS[naming]
+    src = _renamed_with_twists(humanoid, names)
+    sk = humanoid.skeleton
+    m = auto_map(src, _points(src), sk, _points(sk))
+    for orig in ("Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftArm", "LeftForeArm",
+                 "LeftHand", "Head", "Spine2"):
+        assert m.get(names[orig]) == orig, (naming, orig, m.get(names[orig]))
+    assert m.get(names["LeftLeg"].replace("_l", "_r").replace(" L ", " R ")
+                 .replace("Left", "Right")) == "RightLeg"
