@@ -114,9 +114,9 @@ def _shared(*parts):
 CHARACTERS = [(XBOT, c) for c in ("walk", "run", "idle", "agree", "headShake", "sad_pose",
                                   "sneak_pose")] + [
     pytest.param((_shared("khronos-gltf", "CesiumMan.glb"), None), marks=pytest.mark.xfail(
-        reason="the floor: the motion's (5th percentile of its lowest foot joint) is 14.5 mm "
-               "below the rest's, so the retarget lowers the figure by that (retarget.py's "
-               "floor rule)", strict=False)),
+        reason="the floor: the motion's (5th percentile of its lowest foot joint) is not the "
+               "rest's, so the retarget raises the figure 14.5 mm (retarget.py's floor rule)",
+        strict=False)),
     (_shared("khronos-gltf", "RiggedFigure.glb"), None),
     (_shared("khronos-gltf", "RiggedSimple.glb"), None),
     (_shared("threejs-characters", "RobotExpressive.glb"), "Walking"),
