@@ -192,6 +192,7 @@ def variants(full):
     out = {"idw": ("idw", {}), "heat": ("heat", {})}
     if full:
         out.update({f"heat, c={c:g}": ("heat", {"c": c}) for c in (1.0, 2.0, 3.0, 8.0)})
+        out["heat, min weight 0.01"] = ("heat", {"min_weight": 0.01})
         out.update({
             "heat, helpers kept": ("heat", {"helpers": False}),
             "heat, every part blocks": ("heat", {"own_part": False}),

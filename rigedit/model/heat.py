@@ -54,7 +54,7 @@ TIE = 1e-4              # bones within this relative distance of the nearest sha
 MAX_ROUNDS = 8          # how many nearest bones to try before a vertex sees none
 BEHIND = -0.1           # see ``behind`` in heat_weights
 RING_BEHIND = 0.75      # see _visible
-MIN_WEIGHT = 0.01       # influences below this (after top-K) are dropped
+MIN_WEIGHT = 0.025      # influences below this (after top-K) are dropped (Blender: 0.025)
 WELD = 1e-6             # weld distance, as a fraction of the bounding-box diagonal
 CHUNK = 16384           # vertices per block of the distance computation
 
