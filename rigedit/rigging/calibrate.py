@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.transforms import compose_trs
 from .name_map import find_slots
 
 __all__ = ["Calibration", "calibrate", "model_stack", "swing", "unit", "rotations_of",
@@ -67,17 +68,37 @@ def rotations_of(mats):
 
 
 def model_stack(skeleton, clip, times):
-    """Model matrices of a clip at each time.
+    """Model matrices of a clip at each time, all frames at once: a track keyed at exactly
+    the sample times gives its keys (a BVH's or a baked clip's, the usual case), any other is
+    sampled; then one batched product per tree depth over every frame.
 
     Returns
     -------
     mats : (F, J, 4, 4) float64
     """
-    out = np.empty((len(times), len(skeleton), 4, 4))
-    pose = None
-    for f, t in enumerate(times):
-        pose = clip.sample(t, out=pose)
-        skeleton.forward(pose.local_matrices(), out=out[f])
+    n_frames, nj = len(times), len(skeleton)
+    local_t = np.array([clip.local_time(t) for t in times])
+    channels = {"translation": np.broadcast_to(skeleton.rest_translation, (n_frames, nj, 3)),
+                "rotation": np.broadcast_to(skeleton.rest_rotation, (n_frames, nj, 4)),
+                "scale": np.broadcast_to(skeleton.rest_scale, (n_frames, nj, 3))}
+    channels = {k: v.copy() for k, v in channels.items()}
+    for (joint, channel), track in clip.tracks.items():
+        j = skeleton.index[joint]
+        if len(track.times) == n_frames and np.allclose(track.times, local_t, rtol=0.0,
+                                                        atol=1e-9):
+            values = track.values
+            if channel == "rotation":  # a cubic spline's keys may be kept as given
+                values = values / np.linalg.norm(values, axis=1, keepdims=True)
+        else:
+            values = np.array([track.sample(t) for t in local_t])
+        channels[channel][:, j] = values
+    local = compose_trs(channels["translation"].reshape(-1, 3),
+                        channels["rotation"].reshape(-1, 4),
+                        channels["scale"].reshape(-1, 3)).reshape(n_frames, nj, 4, 4)
+    out = np.empty_like(local)
+    out[:, skeleton.levels[0]] = local[:, skeleton.levels[0]]
+    for idx in skeleton.levels[1:]:
+        out[:, idx] = out[:, skeleton.parents[idx]] @ local[:, idx]
     return out
 
 
