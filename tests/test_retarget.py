@@ -150,8 +150,9 @@ def test_contacts_slip_less_and_feet_above_floor(src, tgt, results):
 def test_identity_reproduces_source():
     """Onto a copy of itself every joint comes back, lowered from the motion's floor (its
     feet's level over the clip) onto the target's floor (its feet at rest: the BVH rest has
-    the hips at the origin). The toes alone move a little: the feet are pitched relative to
-    the target's rest foot, which is a few degrees off the motion's own flat foot."""
+    the hips at the origin). The toes too: they point 11-18 degrees off their rest during the
+    motion's contacts, but the two feet are one build, so each foot points as the source's
+    (the toes moved 7 mm when the target's flat foot was taken from its rest)."""
     src = _load(CMU)
     copy = _load(CMU)
     res = retarget_result(src, "take", copy, clean_feet=False)
@@ -164,9 +165,7 @@ def test_identity_reproduces_source():
         want = src.skeleton.forward(src.clips["take"].sample(t).local_matrices())[:, :3, 3]
         got = sk.forward(res.clip.sample(t).local_matrices())[:, :3, 3]
         err = np.abs(got - want - [0, shift, 0]).max(axis=1)
-        toes = [sk.index["LeftToe"], sk.index["RightToe"]]
-        assert np.delete(err, toes).max() < 1e-6 * copy.height()
-        assert err[toes].max() < 0.01  # measured 7 mm
+        assert err.max() < 1e-6 * copy.height()
 
 
 def test_facing_backwards_source_is_turned(humanoid):

@@ -124,6 +124,7 @@ CHARACTERS = [(XBOT, c) for c in ("walk", "run", "idle", "agree", "headShake", "
     (_shared("quaternius-farm-animals", "Horse.gltf"), "Walk"),
     ("humanoid", "walk"), ("humanoid", "wave"), ("humanoid", "idle"),
     ("quadruped", "walk"), ("quadruped", "run"),
+    (_shared("bvh-cmu", "131_01.bvh"), None),
     (_shared("bvh-bandai", "dataset-1_walk_normal_002.bvh"), None),
     (_shared("bvh-library", "bandai-2", "dataset-2_walk_active_001.bvh"), None),
     (_shared("bvh-library", "cmu-iclone", "005_01.bvh"), None),

@@ -10,11 +10,14 @@ from .chains import distribute_bend
 from .limbs import ancestors
 
 __all__ = ["transfer_rotations", "end_spec", "end_points", "pitch_of", "pitched",
-           "FLAT_AGREE"]
+           "FLAT_AGREE", "SAME_FOOT"]
 
 #: Degrees within which the source's rest foot and its median foot during contacts are taken
 #: for the same flat foot (then the rest's is used).
 FLAT_AGREE = 15.0
+#: Degrees within which two rests' foot bones pitch alike (with their lengths in the same
+#: proportion to the legs) for the feet to count as one build.
+SAME_FOOT = 0.5
 
 
 def end_spec(skeleton, calib, j, mapped, next_in_chain):
@@ -118,8 +121,15 @@ def transfer_rotations(src, tgt, inverse, smats, scal, rf, contact):
                 if src.source == "rest" and abs(s_flat - pitch_of(vs)) < np.radians(FLAT_AGREE):
                     s_flat = float(pitch_of(vs))
                 # a target calibrated on a clip's frame (its rest does not stand) has no known
-                # flat foot: the foot points as the source's
-                t_flat = pitch_of(vt) if tgt.source == "rest" else s_flat
+                # flat foot, and a foot built as the source's (the same pitch in both rests,
+                # the same length for the leg) has the source's: the foot points as the
+                # source's (CMU 131_01 onto itself: its toes point 11-18 degrees off their rest
+                # during its contacts)
+                same = tgt.source == src.source and \
+                    abs(pitch_of(vt) - pitch_of(vs)) < np.radians(SAME_FOOT) and \
+                    abs(np.linalg.norm(vt) / tgt.hip_height
+                        - np.linalg.norm(vs) / src.hip_height) < 1e-3
+                t_flat = pitch_of(vt) if tgt.source == "rest" and not same else s_flat
                 want = pitched(want, s_flat - t_flat)
             r = swing(r @ u, want) @ r
             pairs.append((j, t_spec, s, s_spec))
