@@ -152,3 +152,21 @@ def test_part_filtered_rays_agree_between_kernels():
     b = SurfaceRays(v, f, parts=parts, use_numba=False).first_hit(o, e, part=part)
     np.testing.assert_allclose(a, b)
     assert np.isfinite(a).sum() > 100 and (a != SurfaceRays(v, f).first_hit(o, e)).any()
+
+
+def test_neighbouring_bones_on_a_thin_limb_blend_over_about_its_radius():
+    # The blend between two bones spans about d / sqrt(c), d the limb's radius. With c = 1
+    # (Baran and Popovic; half of Blender's in effect) a 0.1-thick limb still gave 11% of
+    # the next bone 1.5 radii from the joint; artists blend tighter (README: c = 4).
+    v, f = cylinder(radius=0.1, height=2.0, rings=81, segments=24)
+    sk = skeleton(["upper", "lower"], [-1, 0], [[0, 0, 0], [0, 1.0, 0]],
+                  [[np.nan] * 3, [0, 2.0, 0]])
+    side = np.isclose(np.hypot(v[:, 0], v[:, 2]), 0.1)
+    ys = np.round(v[:, 1], 6)
+
+    def far_share(w, y):  # the lower bone's mean weight on the ring at height y
+        return w[side & np.isclose(ys, y), 1].mean()
+    w = heat(v, sk, f)
+    assert 0.45 < far_share(w, 1.0) < 0.55                     # shared at the joint
+    assert far_share(w, 0.85) < 0.05 and far_share(w, 0.8) == 0.0
+    assert far_share(heat(v, sk, f, c=1.0), 0.85) > 0.1
