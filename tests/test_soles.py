@@ -78,6 +78,21 @@ def deep_heels(humanoid):
     return box_feet_rig(sk, boxes, "deep heels")
 
 
+def box_hooves(quadruped):
+    """The bundled quadruped's skeleton with box hooves 24 cm long and 8 cm wide around the
+    hoof joints, down to the floor, weighted half to the hoof and half to the cannon."""
+    sk = quadruped.skeleton
+    p = sk.bind_matrices[:, :3, 3]
+    boxes = {}
+    for end in ("fore", "hind"):
+        for side in "LR":
+            c = p[sk.index[f"{end}_hoof_{side}"]]
+            boxes[f"{end}_hoof_{side}"] = (c - [0.04, c[1], 0.12], c + [0.04, 0.05, 0.12],
+                                           {f"{end}_hoof_{side}": 0.5,
+                                            f"{end}_cannon_{side}": 0.5})
+    return box_feet_rig(sk, boxes, "box hooves")
+
+
 def _passthrough(rig, tgt, rot, hips_pos, mats, *args, **kwargs):
     return rot, hips_pos, mats
 
@@ -119,16 +134,7 @@ def test_quadruped_hooves_on_the_floor(quadruped):
     cannon's swing dips them, which the joints' clean-up (hoof joints and tips) does not see. On the
     walk every hoof's lowest skin point stays above the floor, stands on it and does not
     slide (the legs path, :class:`LegCalibration`)."""
-    sk = quadruped.skeleton
-    p = sk.bind_matrices[:, :3, 3]
-    boxes = {}
-    for end in ("fore", "hind"):
-        for side in "LR":
-            c = p[sk.index[f"{end}_hoof_{side}"]]
-            boxes[f"{end}_hoof_{side}"] = (c - [0.04, c[1], 0.12], c + [0.04, 0.05, 0.12],
-                                           {f"{end}_hoof_{side}": 0.5,
-                                            f"{end}_cannon_{side}": 0.5})
-    target = box_feet_rig(sk, boxes, "box hooves")
+    target = box_hooves(quadruped)
     with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
         before = _skin_measures(retarget_result(quadruped, "walk", target), target, quadruped)
     after = _skin_measures(retarget_result(quadruped, "walk", target), target, quadruped)
@@ -210,3 +216,12 @@ def test_ramp_fades_over_blend_frames():
     m[4:6] = True
     np.testing.assert_allclose(ramp(m, 2), [0, 0, 1 / 3, 2 / 3, 1, 1, 2 / 3, 1 / 3, 0, 0])
     assert not ramp(np.zeros(3, bool), 2).any()
+
+
+def test_soles_left_off_the_floor_are_reported(quadruped):
+    """With one round only, the half-cannon-weighted hooves (see above) stay off: one
+    warning says how far and in how many frames, never a silent result."""
+    target = box_hooves(quadruped)
+    with mock.patch("rigedit.rigging.soles.ROUNDS", 1):
+        with pytest.warns(UserWarning, match=r"skinned soles stay up to [0-9.]+ mm off"):
+            retarget_result(quadruped, "walk", target)

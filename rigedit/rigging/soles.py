@@ -527,6 +527,11 @@ def hold_soles(rig, tgt, rot, hips_pos, mats, contact, clearance, times, mapped,
         moved = np.abs(change) > tol
         gain = np.where(moved, np.clip((low - before) / np.where(moved, change, 1.0),
                                        0.3, 3.0), gain)
+    off = (np.abs(goal - low) > 1e-3 * tgt.hip_height).any(axis=1)
+    if off.any():  # the rounds ran out: say so, not silently
+        warnings.warn(f"{what}: the skinned soles stay up to {1000 * np.abs(goal - low).max():.1f}"
+                      f" mm off where they should stand in {int(off.sum())} of {len(times)} "
+                      f"frames (the feet's skin does not follow the ankles)", stacklevel=2)
     return rot, hips_pos, mats
 
 
