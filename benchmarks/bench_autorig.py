@@ -1,6 +1,11 @@
 """Auto-rigging: time of each stage, and joint placement (CD-J2J) through the whole pipeline.
 
-Run: ``.venv/bin/python benchmarks/bench_autorig.py [--speed] [--accuracy]`` (both by default).
+Run: ``.venv/bin/python benchmarks/bench_autorig.py [--speed] [--accuracy]
+[--orientations STEP]`` (speed and accuracy by default).
+
+**Orientations** (``--orientations STEP``): each mesh below turned by every STEP-th of the
+24 axis-aligned turns, the whole pipeline run with the orientation guessed (and searched):
+recovered within 5 degrees and sure, flagged NOT SURE, or wrong but sure (a failure).
 
 **Speed**: ``rigedit.autorig`` with heat weights and the template's clips on
 - 50k-vertex meshes: the bundled humanoid's mesh (24,999 vertices) split once at edge
@@ -43,6 +48,7 @@ from rigedit.embedding import cd_j2j  # noqa: E402
 from rigedit.rigging.mesh_check import read_mesh  # noqa: E402
 # the artists' joints that the humanoid template's joints map onto (the embedding tests')
 from test_embedding import DATA, KHRONOS  # noqa: E402
+from test_autorig_orient import TURNS  # noqa: E402  (the 24 axis turns)
 
 # rigedit axis -> the turned input's: up is the input's +Z, forward its -X (left: -Y)
 TURN = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
@@ -143,14 +149,79 @@ def accuracy():
                   f"{cd_j2j(pred, truth_rig, diag):.2f}% |")
 
 
+def orientations(step):
+    """The whole pipeline (idw weights, no clips: the orientation search is what is timed)
+    on each mesh turned by every ``step``-th of the 24 axis turns: the orientation
+    recovered within 5 degrees, or flagged (not sure); a wrong one reported sure is a
+    failure."""
+    from rigedit.rigging.mesh_check import read_mesh as read
+
+    meshes = []
+    for name, template, up, fwd in (("humanoid", "humanoid", [0, 1, 0], [0, 0, 1]),
+                                    ("quadruped", "quadruped", [0, 1, 0], [0, 0, 1]),
+                                    ("homer.obj", "humanoid", [0, 1, 0], [0, 0, 1]),
+                                    ("cow.obj", "quadruped", [0, 1, 0], [1, 0, 0])):
+        if name in ("humanoid", "quadruped"):
+            rig = rigedit.load_rig(name)
+            meshes.append((f"bundled {name}", rig.vertices, rig.faces, template, up, fwd))
+        else:
+            path = DATA / "common-3d-test-models" / name
+            if path.is_file():
+                meshes.append((name, *read(path), template, up, fwd))
+    for file in KHRONOS:
+        path = DATA / "khronos-gltf" / file
+        if path.is_file():
+            rig = rigedit.load_rig(path)
+            meshes.append((file, rig.skin(rig.rest_pose()), rig.faces, "humanoid", [0, 1, 0],
+                           [0, 0, 1]))
+    turns = TURNS[::step]
+    print(f"## Orientation search: {len(turns)} of the 24 axis turns per mesh")
+    print("| mesh | turns | recovered and sure | flagged (not sure) | wrong but sure | "
+          "seconds per run (median, max) |")
+    print("|---|---|---|---|---|---|")
+    for label, v, f, template, up, fwd in meshes:
+        counts = {"ok": 0, "flagged": 0, "wrong": 0}
+        times, wrong = [], []
+        for m in turns:
+            t0 = time.perf_counter()
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    rep = rigedit.autorig((v @ m.T, f), template=template, clips=False,
+                                          weights="idw").autorig_report
+            except ValueError as exc:
+                counts["flagged"] += 1      # refused, with the reason: nothing silent
+                wrong.append(f"refused: {exc}")
+                continue
+            times.append(time.perf_counter() - t0)
+            o = rep.orientation
+            off = max(np.degrees(np.arccos(np.clip(o.up @ (m @ up), -1, 1))),
+                      np.degrees(np.arccos(np.clip(o.forward @ (m @ fwd), -1, 1))))
+            if not rep.sure:
+                counts["flagged"] += 1
+            elif off <= 5.0:
+                counts["ok"] += 1
+            else:
+                counts["wrong"] += 1
+                wrong.append(f"{o.describe()} for up {(m @ up).tolist()}")
+        print(f"| {label} | {len(turns)} | {counts['ok']} | {counts['flagged']} | "
+              f"{counts['wrong']} | {np.median(times):.1f}, {max(times):.1f} |")
+        for w in wrong:
+            print(f"  - {label}: {w}")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--speed", action="store_true")
     p.add_argument("--accuracy", action="store_true")
+    p.add_argument("--orientations", type=int, default=0, metavar="STEP",
+                   help="the orientation search on every STEP-th axis turn (1: all 24)")
     args = p.parse_args()
     print(f"load average at start: {' '.join(f'{x:.1f}' for x in os.getloadavg())} "
           f"({os.cpu_count()} cores; other jobs share the machine)")
-    both = not (args.speed or args.accuracy)
+    if args.orientations:
+        orientations(args.orientations)
+    both = not (args.speed or args.accuracy or args.orientations)
     if args.speed or both:
         speed()
     if args.accuracy or both:

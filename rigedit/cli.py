@@ -263,6 +263,9 @@ def build_parser():
                         "(repeatable)")
     s.add_argument("--hints", default=None, metavar="FILE.json",
                    help="pin joints from a JSON object {joint: [x, y, z]} (--hint wins)")
+    s.add_argument("--strict", action="store_true",
+                   help="a result that is NOT SURE (a failed check, an orientation without a "
+                        "clear winner) is an error: exit 2, nothing written")
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     s.add_argument("-o", "--output", required=True, metavar="RIG_FOLDER|OUT.glb")
     s.set_defaults(func=cmd_autorig)

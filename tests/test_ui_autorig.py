@@ -236,6 +236,37 @@ def test_result_without_report_still_opens(window, qtbot, monkeypatch, small_hum
     assert w.document.modified and w.document.mode == "edit"
 
 
+def test_not_sure_result_says_why_and_selects_the_joint_in_doubt(window, qtbot, monkeypatch,
+                                                                 small_humanoid_obj):
+    from rigedit.rigging.orient import Orientation
+
+    w = window
+
+    def fake(mesh, template="humanoid", up=None, forward=None, progress=None, **kw):
+        v, f = load_mesh(mesh)
+        rig = Rig(rigedit.load_rig(template).skeleton, v, f, weights_method="idw",
+                  name=Path(mesh).stem)
+        rig.autorig_report = SimpleNamespace(
+            orientation=Orientation(np.array([0.0, 1, 0]), np.array([0.0, 0, 1]),
+                                    guessed=True),
+            clips={}, seconds={"total": 1.0}, sure=False,
+            reasons=["the left arm or limb (LeftHand) shares a part of the mesh with another "
+                     "limb", "Neck is off the middle plane"],
+            doubtful=["LeftForeArm", "LeftHand", "Neck"])
+        return rig
+
+    monkeypatch.setattr(rigedit, "autorig", fake, raising=False)
+    dlg = _open_dialog(w, qtbot)
+    _fill(dlg, monkeypatch, small_humanoid_obj)
+    dlg.ok_button.click()
+    qtbot.waitUntil(lambda: w.job is None, timeout=60000)
+    message = w.statusBar().currentMessage()
+    assert "NOT SURE: the left arm or limb (LeftHand) shares" in message, message
+    assert "(and 1 more)" in message
+    assert w.document.mode == "edit"
+    assert w.document.selection == w.document.rig.skeleton.index["LeftForeArm"]
+
+
 def test_real_autorig_lets_the_cancel_through(small_humanoid_obj):
     # the editor's Cancel is an exception raised from the progress callback: autorig must
     # let it through (not turn it into a bad-input error), whatever stage it is in

@@ -11,8 +11,11 @@ def run_autorig(args):
     """Auto-rig ``args.mesh`` with ``args.template``, print the report, write ``args.output``.
 
     A progress bar shows on a terminal; Ctrl-C or SIGTERM stops the work between steps
-    (see :mod:`rigedit.cli_output`)."""
+    (see :mod:`rigedit.cli_output`). A result that is NOT SURE (``report.sure``) prints
+    each reason as a warning line; with ``args.strict`` it is an error and nothing is
+    written."""
     from ..cli_output import check_interrupted, warning_lines
+    from ..errors import RigFileError
     from .autorig import autorig
 
     read_hints(getattr(args, "hint", None), getattr(args, "hints", None))  # before the bar
@@ -38,8 +41,15 @@ def run_autorig(args):
         finally:   # closed before the warnings print
             if bar is not None:
                 bar.close()
-    for line in rig.autorig_report.lines():
+    report = rig.autorig_report
+    if not report.sure and getattr(args, "strict", False):
+        raise RigFileError(args.mesh, "NOT SURE of the rig: " + "; ".join(report.reasons)
+                           + " (nothing written; give --up/--forward or --hint, or drop "
+                             "--strict)")
+    for line in report.lines():
         print(line)
+    for reason in report.reasons:   # after the report, where a user looks last
+        print(f"rigedit: warning: NOT SURE: {reason}", file=sys.stderr)
     rig.save(args.output)
     print(f"wrote {Path(args.output).resolve()}: {len(rig.skeleton)} joints, "
           f"{len(rig.vertices)} vertices, clips: {' '.join(sorted(rig.clips)) or '-'}")

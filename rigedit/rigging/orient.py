@@ -37,6 +37,10 @@ them (files are almost always saved axis-aligned). Measured on the bundled meshe
 homer, CesiumMan and RiggedFigure: all 24 axis-aligned turns of each recovered and sure; 80
 random turns of each: all recovered within 5.5 degrees and sure, but one of the elk's (no
 ground found: "not sure", and wrong).
+
+The guess is not the last word: :func:`hypotheses` offers it with the frames it most often
+confuses (up reversed, the other in-plane axis up, the axis-aligned frames near each) and
+:mod:`.orient_search` lets the embedding's fit decide among them.
 """
 from __future__ import annotations
 
@@ -49,7 +53,8 @@ from .calibrate import unit
 from .ground import angle, find_ground, support_up
 from .mirror import surface_samples, symmetry_plane, volume_centroid
 
-__all__ = ["Orientation", "orient", "check_axes", "parse_axis", "axis_name", "SNAP_DEGREES"]
+__all__ = ["Orientation", "orient", "hypotheses", "check_axes", "parse_axis", "axis_name",
+           "SNAP_DEGREES", "HYPOTHESES"]
 
 SNAP_DEGREES = 5.0
 SURE_ELONGATION = 1.25
@@ -59,6 +64,12 @@ END_SLICE = 0.03
 SURE_GROUND_TURN = 10.0
 SURE_FORWARD = 0.01
 SURE_SYMMETRY = 0.03   # mean mirror mismatch, as a fraction of the size, for "symmetric"
+#: Orientations :func:`hypotheses` offers at most (each costs an embedding, 1-2 s).
+HYPOTHESES = 4
+#: A guessed frame within this of an axis-aligned one also offers that one (files are
+#: almost always saved along their axes; a long neck tilts the principal axes by tens of
+#: degrees).
+NEAR_AXES_DEGREES = 40.0
 
 AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -297,3 +308,75 @@ def orient(vertices, faces, upright=True, up=None, forward=None):
     if snapped is not None:
         up, forward = snapped
     return Orientation(up, forward, guessed=True, sure=bool(sure), notes=notes)
+
+
+def _aligned(up, forward):
+    """The axis-aligned frame nearest (up, forward) within ``NEAR_AXES_DEGREES``, or None."""
+    def near(v):
+        k = int(np.argmax(np.abs(v)))
+        if np.degrees(np.arccos(min(1.0, abs(v[k])))) > NEAR_AXES_DEGREES:
+            return None
+        return np.eye(3)[k] * np.sign(v[k])
+    a, b = near(up), near(forward)
+    if a is None or b is None or abs(a @ b) > 0:
+        return None
+    return a, b
+
+
+def hypotheses(vertices, faces, upright=True, up=None, forward=None, limit=HYPOTHESES):
+    """Plausible orientations of a mesh, the guess of :func:`orient` first.
+
+    The guess's mirror plane (the left-right axis) is the most reliable of its decisions;
+    which of the two in-plane axes is vertical, and which way up and forward point, are
+    where it goes wrong (a big head above the centre of volume, a cow's neck tilting its
+    principal axes). So the hypotheses are: the guess; up reversed; the other in-plane axis
+    up (either way); each with forward from the guess's cue (:func:`_forward_cue`), and the
+    axis-aligned frame near each one that is off the file's axes. A long (quadruped)
+    template also gets the guess with forward reversed (head and tail tell the embedding
+    apart). Given axes stay: with ``up`` given only forward turns, with ``forward`` given
+    only up. The embedding's fit decides among them (:mod:`.orient_search`).
+
+    Returns
+    -------
+    list of Orientation
+        At most ``limit``, distinct (no two frames within ``SNAP_DEGREES``), the guess first;
+        ``[given]`` when both axes are given.
+    """
+    guess = orient(vertices, faces, upright=upright, up=up, forward=forward)
+    if not guess.guessed:
+        return [guess]
+    given_up, given_fwd = check_axes(up, forward)
+    points = surface_samples(np.asarray(vertices, dtype=np.float64),
+                             np.asarray(faces, dtype=np.int64))
+    g_up, g_fwd = guess.up, guess.forward
+    left = np.cross(g_up, g_fwd)
+
+    def with_cue(u):
+        f = unit(np.cross(left, u))
+        return u, (f if _forward_cue(points, u, f, upright) >= 0 else -f)
+    frames = [(g_up, g_fwd)]
+    if given_up is not None:
+        frames += [(g_up, -g_fwd), (g_up, unit(np.cross(g_up, g_fwd))),
+                   (g_up, -unit(np.cross(g_up, g_fwd)))]
+    elif given_fwd is not None:
+        frames += [(-g_up, g_fwd), (left, g_fwd), (-left, g_fwd)]
+    else:
+        if not upright:
+            frames.append((g_up, -g_fwd))
+        frames += [with_cue(-g_up), with_cue(g_fwd), with_cue(-g_fwd)]
+    out = []
+    for u, f in frames:
+        for cand in ((u, f), _aligned(u, f)):
+            if cand is None or len(out) >= limit:
+                continue
+            if any(angle(cand[0], o.up) < SNAP_DEGREES and angle(cand[1], o.forward)
+                   < SNAP_DEGREES for o in out):
+                continue
+            if not out:
+                out.append(guess)
+            else:
+                u, f = (np.asarray(c, dtype=np.float64) for c in cand)
+                # the forward cue of this frame (signed: < 0 when it says the other way)
+                out.append(Orientation(u, f, guessed=True, sure=False, notes={
+                    "forward": _forward_cue(points, u, f, upright)}))
+    return out

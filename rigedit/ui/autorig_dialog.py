@@ -1,6 +1,7 @@
 """File > Auto-rig mesh: a dialog (mesh, template, up and forward axes) that runs
 :func:`rigedit.autorig` off the UI thread and opens the result as a new, unsaved character in
-bind (edit) mode, so the user can fix joints at once.
+bind (edit) mode, so the user can fix joints at once; when the result is NOT SURE the status
+bar says why and the first joint in doubt is selected.
 
 The work runs through :meth:`MainWindow.run_job` (progress bar with the stage's name, Cancel).
 Bad input (a mesh that is not closed, a template file that is not a skeleton, a mesh with
@@ -37,8 +38,9 @@ def template_path(path):
 
 def describe_report(report):
     """One line for the status bar from ``rig.autorig_report``
-    (:class:`rigedit.rigging.autorig.AutorigReport`): the orientation used and whether it was
-    guessed (and sure), the template clips that came along, and each stage's time.
+    (:class:`rigedit.rigging.autorig.AutorigReport`): NOT SURE and the first reason when a
+    check failed, the orientation used and whether it was guessed (and sure), the template
+    clips that came along, and each stage's time.
 
     Returns
     -------
@@ -53,6 +55,11 @@ def describe_report(report):
                                          "guessed, NOT SURE: check it, or choose Up and "
                                          "Forward in the dialog")
     parts = [f"up {axis_name(o.up)}, forward {axis_name(o.forward)} ({how})"]
+    reasons = getattr(report, "reasons", [])
+    if not getattr(report, "sure", True) and reasons:
+        # the first reason in full (the joints in doubt are selected), the count of others
+        parts.insert(0, f"NOT SURE: {reasons[0]}"
+                     + (f" (and {len(reasons) - 1} more)" if len(reasons) > 1 else ""))
     left_out = [name for name, how in report.clips.items() if how != "retargeted"]
     if left_out:
         parts.append(f"clips left out: {', '.join(left_out)}")
@@ -243,6 +250,10 @@ class AutorigAction:
             rig.name = mesh.stem
         self.w.document.set_rig(rig, modified=True)
         self.w.set_mode("edit")
+        doubtful = [n for n in getattr(getattr(rig, "autorig_report", None), "doubtful", [])
+                    if n in rig.skeleton.index]
+        if doubtful:   # the first joint in doubt, ready to drag (the status bar says why)
+            self.w.document.select(rig.skeleton.index[doubtful[0]])
         about = describe_report(getattr(rig, "autorig_report", None))
         # short enough for the status bar beside the mode label; counts are in Info
         self.w.status(f"Auto-rigged {mesh.name}" + (f": {about}" if about else "")
