@@ -170,3 +170,52 @@ def test_neighbouring_bones_on_a_thin_limb_blend_over_about_its_radius():
     assert 0.45 < far_share(w, 1.0) < 0.55                     # shared at the joint
     assert far_share(w, 0.85) < 0.05 and far_share(w, 0.8) == 0.0
     assert far_share(heat(v, sk, f, c=1.0), 0.85) > 0.1
+
+
+def capsule(a, b, radius):
+    """A closed tube from point a to point b (the builders' cylinder turned onto a -> b)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    length = np.linalg.norm(b - a)
+    v, f = cylinder(radius=radius, height=length, rings=max(4, int(length / radius * 3)),
+                    segments=16)
+    y = (b - a) / length
+    x = np.cross(y, [0.0, 0.0, 1.0] if abs(y[2]) < 0.9 else [1.0, 0.0, 0.0])
+    x /= np.linalg.norm(x)
+    z = np.cross(x, y)
+    return v @ np.stack([x, y, z]) + a, f
+
+
+def test_a_quadruped_with_a_ground_root_and_foot_targets_keeps_legs_apart():
+    # The horse's rig (Quaternius): a root on the ground carrying the body and four foot IK
+    # targets that deform the hooves. A stand-in for the held-back fox, llama, sheep, zebra
+    # and pug: separate parts (trunk, legs, neck, tail), as low-poly animals often are.
+    parts = [capsule([0, 1.2, -1.0], [0, 1.2, 1.0], 0.35),
+             capsule([0, 1.3, 0.9], [0, 1.9, 1.3], 0.15),
+             capsule([0, 1.3, -1.0], [0, 0.9, -1.5], 0.06)]
+    legs = [(sx, sz) for sz in (0.8, -0.8) for sx in (0.25, -0.25)]
+    parts += [capsule([sx, 0.05, sz], [sx, 1.1, sz], 0.1) for sx, sz in legs]
+    v = np.concatenate([p[0] for p in parts])
+    offsets = np.cumsum([0] + [len(p[0]) for p in parts])
+    f = np.concatenate([p[1] + o for p, o in zip(parts, offsets)])
+    names = ["root", "Body", "Hips", "Shoulders", "Neck", "Head", "Tail1", "Tail2"]
+    parents = [-1, 0, 1, 1, 3, 4, 2, 6]
+    heads = [[0, 0, 0], [0, 1.0, 0], [0, 1.25, -0.7], [0, 1.25, 0.7], [0, 1.4, 1.0],
+             [0, 1.8, 1.25], [0, 1.3, -1.0], [0, 1.1, -1.25]]
+    for n, (sx, sz) in enumerate(legs):
+        side, end = ("L" if sx > 0 else "R"), ("Front" if sz > 0 else "Back")
+        names += [f"{end}UpLeg.{side}", f"{end}LowLeg.{side}", f"{end}Foot.{side}"]
+        parents += [3 if sz > 0 else 2, len(names) - 3, 0]
+        heads += [[sx, 1.0, sz], [sx, 0.5, sz], [sx, 0.1, sz]]
+    sk = skeleton(names, parents, heads)
+    w = heat(v, sk, f)
+    np.testing.assert_allclose(w.sum(axis=1), 1.0)
+    assert w[:, 0].max() == 0.0                                   # the carrier
+    for n in range(4):                                            # each leg is its own
+        own = [8 + 3 * n, 9 + 3 * n, 10 + 3 * n]
+        leg = np.arange(offsets[3 + n], offsets[4 + n])
+        low = leg[v[leg, 1] < 0.6]
+        assert w[np.ix_(low, own)].sum(axis=1).min() > 0.99
+        hoof = leg[v[leg, 1] < 0.1]
+        assert w[hoof, own[2]].min() > 0.5                        # the foot target's
+    before = heat(v, sk, f, helpers=False)
+    assert before[:, 0].max() > 0.3
