@@ -271,3 +271,18 @@ def test_ik_rig_with_feet_under_the_root_retargets_onto_itself_and_a_bigger_copy
 
 def _load_humanoid():
     return rigedit.load_rig("humanoid")
+
+
+def test_cli_retargets_an_ik_rig_by_names_with_one_warning(tmp_path):
+    import subprocess
+    import sys
+
+    folder = tmp_path / "ik"
+    _ik_rig().save(folder)
+    p = subprocess.run([sys.executable, "-m", "rigedit", "retarget", str(folder), "--to",
+                        str(folder), "--strict", "-o", str(tmp_path / "c.json")],
+                       capture_output=True, text=True, cwd=REPO)
+    assert p.returncode == 0, p.stderr
+    warn = [ln for ln in p.stderr.splitlines() if ln.startswith("rigedit: warning:")]
+    assert len(warn) == 1 and "retargeted by joint names (5 of 5 joints)" in warn[0], p.stderr
+    assert "Traceback" not in p.stderr and (tmp_path / "c.json").exists()

@@ -116,8 +116,8 @@ def bare_result(source_rig, source_clip, target_rig, mapping, name, times, sourc
     inverse = {tsk.index[t]: ssk.index[s] for s, t in mapping.items()}
     if tgt.hips not in inverse or len(inverse) < MIN_SHARE * len(tsk):
         return None
-    warnings.warn(f"{target_what}: {reason}; retargeted by joint names ({len(inverse)} of "
-                  f"{len(tsk)} joints) without a floor, facing or foot clean-up")
+    warnings.warn(f"{reason}; retargeted by joint names ({len(inverse)} of {len(tsk)} "
+                  f"joints) without a floor, facing or foot clean-up")
     scale = tgt.size / src.size
     smats = model_stack(ssk, source_clip, times)
     s_rot, s_rest = rotations_of(smats), rotations_of(src.mats)

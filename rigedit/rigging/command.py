@@ -28,6 +28,7 @@ def run_retarget(args, load):
     ``load(path, scale=...)`` reads a rig (the CLI's loader, which prints warnings). A map
     that leaves an arm, a leg, the spine or the head of the target unmapped is a warning
     listing them; with ``args.strict`` an error (nothing is written)."""
+    from ..cli_output import warning_lines
     from .name_map import load_map, save_map, unmapped_parts
     from .retarget import retarget_result
 
@@ -37,9 +38,11 @@ def run_retarget(args, load):
     mapping = None
     if args.map is not None:
         mapping = load_map(args.map, source.skeleton, target.skeleton)
-    # a skeleton with no legs or arms is a ValueError naming the file: the CLI prints it
-    res = retarget_result(source, clip, target, mapping, args.name,
-                          source_what=str(args.motion), target_what=str(args.to))
+    # a skeleton with no legs or arms is a ValueError naming the file: the CLI prints it;
+    # a retarget without legs says so in a warning line
+    with warning_lines():
+        res = retarget_result(source, clip, target, mapping, args.name,
+                              source_what=str(args.motion), target_what=str(args.to))
     print(f"map ({len(res.mapping)} joints, source -> target):")
     for s, t in res.mapping.items():
         print(f"  {s} -> {t}")

@@ -463,8 +463,9 @@ def unmapped_parts(calibration, mapped):
     for leg in calibration.legs:
         if not mapped & set(leg.chain):
             out.append(f"the leg of {sk.names[leg.contact]}")
-    if calibration.chest is not None and calibration.chest not in mapped:
-        out.append(f"spine ({sk.names[calibration.chest]})")
+    chest = getattr(calibration, "chest", None)  # a skeleton without legs has none
+    if chest is not None and chest not in mapped:
+        out.append(f"spine ({sk.names[chest]})")
     return out
 
 
