@@ -51,6 +51,8 @@ STANDING = 0.01
 #: Rounds of IK and re-measuring at most: the skin moves with the ankle but for the vertices
 #: the shin shares, and a hips drop moves the other foot.
 ROUNDS = 8
+#: Frames measured at once (bounds the (frames, N) buffers of a long clip).
+CHUNK = 512
 #: The patch a foot stands on: its vertices within this share of the foot's size of its
 #: lowest (4 mm on a 27 cm foot).
 PATCH = 0.015
@@ -153,17 +155,24 @@ def skin_points(soles, skeleton, mats, rows=None):
 
 
 def vertex_heights(soles, skeleton, mats):
-    """(F, N) model y of every foot vertex in the poses ``mats`` (F, J, 4, 4)."""
+    """(F, N) float32 model y of every foot vertex in the poses ``mats`` (F, J, 4, 4)
+    (float32: a long clip's frames times thousands of vertices stay a few tens of MB, and
+    a tenth of a micrometre is precise enough for a floor)."""
     pal = _palette(soles, skeleton, mats)[:, :, 1, :]             # (F, U, 4)
-    return (soles.lifted @ pal.reshape(len(mats), -1).T).T
+    out = np.empty((len(mats), len(soles.lifted)), dtype=np.float32)
+    for c in range(0, len(mats), CHUNK):
+        out[c:c + CHUNK] = (soles.lifted @ pal[c:c + CHUNK].reshape(len(pal[c:c + CHUNK]),
+                                                                      -1).T).T
+    return out
 
 
 def sole_heights(soles, skeleton, mats, heights=None):
-    """(F, n_feet) model y of each foot's lowest skinned point in each pose (from
+    """(F, n_feet) float64 model y of each foot's lowest skinned point in each pose (from
     ``heights``, :func:`vertex_heights` of ``mats``, when given)."""
     y = vertex_heights(soles, skeleton, mats) if heights is None else heights
     off = soles.offsets
-    return np.stack([y[:, a:b].min(axis=1) for a, b in zip(off[:-1], off[1:])], axis=1)
+    return np.stack([y[:, a:b].min(axis=1) for a, b in zip(off[:-1], off[1:])],
+                    axis=1).astype(np.float64)
 
 
 def bearing_steps(soles, skeleton, mats, heights=None, patch=None):
@@ -196,10 +205,12 @@ def bearing_steps(soles, skeleton, mats, heights=None, patch=None):
     pal = pal.transpose(0, 1, 3, 2).reshape(len(mats), -1, 2)     # (F, 4U, 2)
     out = np.zeros((max(len(mats) - 1, 0), len(off) - 1, 2))
     for i, (a, b) in enumerate(zip(off[:-1], off[1:])):
-        ya = y[:-1, a:b]
-        near = (ya <= ya.min(axis=1, keepdims=True) + patch).astype(np.float64)
-        # the patch's mean lifted vector: its mean position is linear in it
-        z = (near @ soles.lifted[a:b]) / near.sum(axis=1, keepdims=True)
+        z = np.empty((len(out), soles.lifted.shape[1]))
+        for c in range(0, len(out), CHUNK):  # (frames, N) at a time: long clips fit
+            ya = y[c:min(c + CHUNK, len(out)), a:b]
+            near = (ya <= ya.min(axis=1, keepdims=True) + patch).astype(np.float64)
+            # the patch's mean lifted vector: its mean position is linear in it
+            z[c:c + len(ya)] = (near @ soles.lifted[a:b]) / near.sum(axis=1, keepdims=True)
         out[:, i] = (np.einsum("fk,fkc->fc", z, pal[1:])
                      - np.einsum("fk,fkc->fc", z, pal[:-1]))
     return out
