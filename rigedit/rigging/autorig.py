@@ -5,11 +5,15 @@ The pipeline, each stage timed in ``rig.autorig_report.seconds``:
 1. **load/check** (:mod:`.mesh_check`): read the mesh, weld it; a mesh that is not one closed
    body (open, non-manifold, many parts) gets a watertight proxy of its volume, which the
    orientation and the embedding use (the weights stay on the real mesh);
-2. **orient** (:mod:`.orient`): up and forward given or guessed; the mesh is turned into
-   rigedit's frame (+Y up, facing +Z), keeps its units, and is moved to stand on y = 0
-   centred over the origin in x and z (``report.transform``, input -> rig);
+2. **orient** (:mod:`.orient`): up and forward given, or a few hypotheses guessed
+   (:func:`.orient.hypotheses`); in each the mesh is turned into rigedit's frame (+Y up,
+   facing +Z), keeps its units, and is moved to stand on y = 0 centred over the origin in
+   x and z (``report.transform``, input -> rig);
 3. **embedding** (:mod:`rigedit.embedding`, Baran and Popovic's Pinocchio): every template
-   joint placed inside the mesh;
+   joint placed inside the mesh, in each hypothesis; each result checked as a rigger would
+   (:mod:`.confidence`) and scored, the best kept (:mod:`.orient_search`). A failed check or
+   a runner-up within the margin makes the result NOT SURE (``report.sure``,
+   ``report.reasons``, ``report.doubtful``);
 4. **skeleton**: the template's names, hierarchy and deform flags on the embedded positions.
    Joint frames follow the template's: a joint's model-space rest rotation is the
    template's, turned by the smallest rotation taking the template's bone to the embedded one
@@ -33,7 +37,9 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import RigFileError
 from .mesh_check import check_mesh, read_mesh
-from .orient import Orientation, check_axes, orient
+from .confidence import check_embedding, fit_score
+from .orient import SURE_FORWARD, Orientation, check_axes, hypotheses
+from .orient_search import MARGIN, search
 from .templates import load_template, rest_model, template_poses, upright
 
 __all__ = ["autorig", "AutorigReport", "load_template", "template_poses", "build_skeleton",
@@ -73,6 +79,15 @@ class AutorigReport:
     outside : list[str]
         Carried template joints with no geometry around them (collapsed by the embedding
         into their base's region): kept, for the clips, but not deforming.
+    sure : bool
+        Whether every check a rigger would make passed (:mod:`.confidence`) and the
+        orientation won by a clear margin (:mod:`.orient_search`).
+    reasons : list[str]
+        One line per failed check.
+    doubtful : list[str]
+        The joints in doubt (the editor selects them).
+    orientations : list[str]
+        Each orientation tried and its score, best first.
     embedded : (J, 3) float64
         Every template joint as embedded, in the rig's coordinates (the editor's "Re-embed
         around the joints I moved" compares the rest with it).
@@ -93,6 +108,10 @@ class AutorigReport:
     outside: list = field(default_factory=list)
     embedded: np.ndarray = None
     hints: dict = field(default_factory=dict)
+    sure: bool = True
+    reasons: list = field(default_factory=list)
+    doubtful: list = field(default_factory=list)
+    orientations: list = field(default_factory=list)
 
     def lines(self):
         """The report as short lines (the CLI prints them)."""
@@ -104,8 +123,15 @@ class AutorigReport:
         out.append(f"placed: turned into +Y up, facing +Z, moved by ({t[0]:.4g}, {t[1]:.4g}, "
                    f"{t[2]:.4g}) to stand on y = 0")
         out += list(self.checks.lines())
+        if len(self.orientations) > 1:
+            out.append("orientations tried: " + "; ".join(self.orientations))
         out.append(f"embedding: template {self.template} ({self.template_pose} pose), "
                    f"{len(self.placed)} joints placed from the mesh, cost {self.cost:.4g}")
+        out += [f"NOT SURE: {reason}" for reason in self.reasons]
+        out.append("checks: " + ("all passed (limbs, upright, mirror, inside, lengths, "
+                                 "margin)" if self.sure else
+                                 f"NOT SURE, {len(self.reasons)} failed; check "
+                                 f"{', '.join(self.doubtful[:8]) or 'the orientation'}"))
         if self.outside:
             from ..embedding.inside import describe_joints
             out.append(f"{describe_joints(self.outside)}: no geometry, not deforming")
@@ -218,9 +244,31 @@ def _turned(hints, place):
     return out
 
 
+def _verdict(best, tried, frames, upright):
+    """The winning orientation, marked sure or not by the search, and the winner's checks
+    with the margin check added (see :mod:`.orient_search`)."""
+    o, conf = best.orientation, best.confidence
+    if not o.guessed:
+        return o, conf
+    others = [t for t in tried[1:] if np.isfinite(t.score)]
+    margin = others[0].score - best.score if others else np.inf
+    o.notes["tried"] = float(len(tried))
+    o.notes["margin"] = float(margin)
+    # the embedding tells up from down and a turned body, but hardly a biped's front from
+    # its back: that stays the forward cue's
+    cue_ok = not upright or o.notes.get("forward", SURE_FORWARD) >= SURE_FORWARD
+    o.sure = bool(margin >= MARGIN and cue_ok)
+    if margin < MARGIN:
+        conf.fail("margin", f"orientation: {others[0].describe()} fits almost as well as "
+                            f"{best.describe()} (margin {margin:.2f}, under {MARGIN:g})")
+    elif not cue_ok:
+        conf.fail("margin", f"orientation: front and back told apart only by "
+                            f"{o.notes['forward']:.3f} of the height (under {SURE_FORWARD:g})")
+    return o, conf
+
+
 def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", clips=True,
             progress=None, hints=None):
-
     """Rig a static mesh with a template skeleton (see the module notes).
 
     Parameters
@@ -254,6 +302,8 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
         like the template's, a template that is not a skeleton.
     """
     from ..embedding import EmbeddingError, HintError, embed_skeleton
+    from ..embedding.distance import distance_field
+    from ..embedding.template import reduce_template
     from ..model.weights import compute_weights
     from ..rig import Rig
 
@@ -282,32 +332,66 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     t0 = time.perf_counter()
     band("orient")(0.0)
     body_v, body_f = checks.embedding_mesh()     # the body, or a watertight proxy of it
-    orientation = orient(body_v, body_f, upright=upright(poses[0][0]), up=up,
-                         forward=forward)
-    place = _placement(vertices, orientation)
+    stands_tall = upright(poses[0][0])
+    frames = hypotheses(body_v, body_f, upright=stands_tall, up=up, forward=forward)
     seconds["orient"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
     used = np.unique(body_f)
     remap = np.full(len(body_v), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
-    emb_v = body_v[used] @ place[:3, :3].T + place[:3, 3]
     t_mesh = None
     if t_rig is not None and len(t_rig.vertices) and len(t_rig.faces):
         t_mesh = (t_rig.skin(t_rig.rest_pose()), t_rig.faces)   # the rest pose's, as the joints
-    emb = first = None
-    for t_sk, t_pose in poses:   # the first standing pose of the template that fits
-        try:
-            emb = embed_skeleton(emb_v, remap[body_f], t_sk, progress=band("embedding"),
-                                 template_mesh=t_mesh, hints=_turned(hints, place))
-            break
-        except HintError as exc:   # an unknown joint, a point outside the mesh
-            raise RigFileError(source, str(exc)) from None
-        except EmbeddingError as exc:
-            first = first or exc
-    if emb is None:
-        raise RigFileError(source, f"{first} (template {t_name}, orientation "
-                                   f"{orientation.describe()})") from None
+    trials = len(frames)
+
+    def embed(orientation):
+        """(embedding, placement, template skeleton, its pose) in one frame."""
+        place = _placement(vertices, orientation)
+        emb_v = body_v[used] @ place[:3, :3].T + place[:3, 3]
+        first = None
+        for t_sk, t_pose in poses:   # the first standing pose of the template that fits
+            try:
+                emb = embed_skeleton(emb_v, remap[body_f], t_sk, template_mesh=t_mesh,
+                                     progress=lambda f: sub(f / trials),
+                                     hints=_turned(hints, place))
+                return emb, place, t_sk, t_pose
+            except HintError as exc:   # an unknown joint, a point outside the mesh
+                raise RigFileError(source, str(exc)) from None
+            except EmbeddingError as exc:
+                first = first or exc
+        raise first
+
+    reduced, body_field = {}, []
+
+    def check(found):
+        emb, place, t_sk, _ = found
+        if id(t_sk) not in reduced:
+            reduced[id(t_sk)] = reduce_template(t_sk, t_mesh)
+        red = reduced[id(t_sk)]
+        if not body_field:   # one field, in the input's frame, for every frame tried
+            body_field.append(distance_field(body_v[used], remap[body_f]))
+        back = np.linalg.inv(place)
+        return (check_embedding(body_field[0], red, emb.positions, list(t_sk.names),
+                                emb.placed, stands_tall, to_field=back),
+                fit_score(red, emb.positions))
+
+    def sub(f):
+        band("embedding")(done[0] + f)
+    done = [0.0]
+
+    def step(f):
+        done[0] = f
+    tried = search(frames, embed, check, failure=EmbeddingError, progress=step)
+    best = tried[0]
+    if best.result is None:   # nothing fits in any frame tried: the guess's reason
+        guess = next(t for t in tried if t.orientation is frames[0])
+        raise RigFileError(source, f"{guess.error} (template {t_name}, orientation "
+                                   f"{frames[0].describe()}"
+                                   + (f"; {len(tried)} orientations tried" if len(tried) > 1
+                                      else "") + ")") from None
+    emb, place, t_sk, t_pose = best.result
+    orientation, confidence = _verdict(best, tried, frames, stands_tall)
     seconds["embedding"] = time.perf_counter() - t0
     for k, v in emb.seconds.items():
         seconds[f"embedding/{k}"] = v
@@ -346,6 +430,10 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
                                        emb.cost, list(emb.placed), clip_notes, t_pose,
                                        list(emb.outside))
     rig.autorig_report.embedded = np.array(emb.positions)
+    rig.autorig_report.sure = bool(confidence.sure)
+    rig.autorig_report.reasons = list(confidence.reasons)
+    rig.autorig_report.doubtful = list(confidence.doubtful)
+    rig.autorig_report.orientations = [t.describe() for t in tried]
     rig.autorig_report.hints = _turned(hints, place)
     rig.notes["autorig"] = (f"template {t_name}; orientation {orientation.describe()}")
     return rig
