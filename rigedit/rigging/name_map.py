@@ -363,7 +363,7 @@ def finger_pairs(src_skeleton, src_hand, tgt_skeleton, tgt_hand):
 
     s_runs, t_runs = _finger_runs(src_skeleton, src_hand), _finger_runs(tgt_skeleton, tgt_hand)
     pairs = []
-    for finger in s_runs.keys() & t_runs.keys():
+    for finger in [f for f, _ in FINGERS if f in s_runs and f in t_runs]:  # in a fixed order
         a, b = s_runs[finger], t_runs[finger]
         na = [number(src_skeleton, j) for j in a]
         nb = [number(tgt_skeleton, j) for j in b]
