@@ -9,8 +9,13 @@ stands (the calibration pose): the hips are the first joint with two chains goin
 going up, the chest the first joint up the spine with two side chains; in a limb chain the
 knee (elbow) is the joint named so when exactly one is, otherwise the joint between the two
 longest consecutive segments. Sides come from the names (``L``/``R``/``Left``/``Right``,
-``.L``, ``_l``, prefixes such as ``mixamorig:``) when both chains carry one, otherwise from
-the side of the figure's left (``up x forward``, forward from heel to toe).
+``.L``, ``_l``, prefixes such as ``mixamorig:`` and ``CC_Base_``) when both chains carry
+one, otherwise from the side of the figure's left (``up x forward``, forward from heel to
+toe). The legs may hang from a pelvis joint below the hips (iClone), limb chains pass over
+twist and share bones beside the real child, and sizes leave out the joints above the first
+branch (a carrier root may stand metres away). Fingers pair by name and number when both
+hands have them (:func:`finger_pairs`); :func:`unmapped_parts` lists the limbs, spine and
+head a map leaves out.
 """
 from __future__ import annotations
 
@@ -432,7 +437,7 @@ def unmapped_parts(calibration, mapped):
 
     Parameters
     ----------
-    calibration : Calibration or LegCalibration
+    calibration : Calibration, LegCalibration or BareCalibration
         The target's.
     mapped : iterable of int
         The target joints the map reaches.
