@@ -195,6 +195,7 @@ def variants(full):
         out["heat, min weight 0.01"] = ("heat", {"min_weight": 0.01})
         out.update({
             "heat, helpers kept": ("heat", {"helpers": False}),
+            "heat, no IK chain tails": ("heat", {"ik_chains": False}),
             "heat, every part blocks": ("heat", {"own_part": False}),
             "heat, branch centroid": ("heat", {"branches": "centroid"}),
             "heat, leaf tails off": ("heat", {"infer_tails": False}),

@@ -34,7 +34,7 @@ import scipy.sparse as sp
 from . import laplacian as lap
 from .skinning import top_k_influences
 from .helper_joints import helper_joints
-from .tails import branch_tails, deforming_joints, infer_leaf_tails
+from .tails import branch_tails, deforming_joints, ik_chain_tails, infer_leaf_tails
 from .visibility import SurfaceRays
 from .weights import inverse_distance_weights, point_segment_distance
 
@@ -183,7 +183,8 @@ def _factor_solve(A, B, solver="auto"):
 def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None,
                  c=C_HEAT, min_weight=MIN_WEIGHT, front_only=False, normal_bias=False,
                  behind=BEHIND, infer_tails=True, operator="cotan", solver="auto",
-                 use_numba=None, branches="children", helpers=True, own_part=True):
+                 use_numba=None, branches="children", helpers=True, own_part=True,
+                 ik_chains=True):
     """Bone-heat weights of a triangle mesh (see the module notes).
 
     Parameters
@@ -269,6 +270,8 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
     normals = lap.vertex_normals(wv, wf, label)
     deform = deforming_joints(skeleton, wv, normals, helpers=helpers)
     tails = skeleton.tails
+    if ik_chains:
+        tails = ik_chain_tails(skeleton, deform, tails)
     if branches == "centroid":
         tails = branch_tails(skeleton, deform, tails)
     elif branches != "children":

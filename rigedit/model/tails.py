@@ -26,7 +26,7 @@ import numpy as np
 
 from .helper_joints import CARRIER, carrier_candidates, helper_joints
 
-__all__ = ["deforming_joints", "infer_leaf_tails", "branch_tails"]
+__all__ = ["deforming_joints", "infer_leaf_tails", "branch_tails", "ik_chain_tails"]
 
 REACH = 0.8
 MIN_REGION = 3
@@ -181,4 +181,61 @@ def branch_tails(skeleton, deform, tails):
         centre = off.mean(axis=0) if len(off) else np.zeros(3)
         if len(off) >= 2 and np.linalg.norm(centre) > 1e-12:
             tails[j] = heads[j] + centre / np.linalg.norm(centre) * length.min()
+    return tails
+
+
+def ik_chain_tails(skeleton, deform, tails, max_angle=60.0, reach=3.0):
+    """Tails for leaf joints whose chain ends at a foot IK target: the target's head.
+
+    Rigs made for IK (Quaternius' animals, RobotExpressive) end a leg chain at a leaf (the
+    lower leg) and put the foot under the root as the IK target, at the hoof. The lower
+    leg's bone runs down to that target, but a tail inferred from the mesh stops halfway:
+    the target's own inferred tail, pointing up the shin, takes the lower half (the horse's
+    shins went 0.69 to the foot target; the artist gave them 0.94 to the lower leg).
+
+    A tail-less deforming leaf ``L`` whose parent is not a root takes as its tail the head of
+    the nearest *target*: a leaf whose parent is a root, not ``L``'s own root chain's
+    ancestor, within ``reach`` times ``L``'s parent bone and within ``max_angle`` degrees of
+    that bone's direction. Each target serves one leaf (the nearest).
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+    deform : (J,) bool
+    tails : (J, 3) float64
+        NaN rows where a joint has no tail.
+
+    Returns
+    -------
+    tails : (J, 3) float64
+        A copy with those tails filled in.
+    """
+    heads = skeleton.bind_matrices[:, :3, 3]
+    parents = skeleton.parents
+    tails = tails.copy()
+    leaf = np.array([len(skeleton.children(j)) == 0 for j in range(len(parents))])
+    targets = [t for t in np.flatnonzero(leaf) if parents[t] >= 0 and parents[parents[t]] < 0]
+    if not targets:
+        return tails
+    pairs = []
+    for j in np.flatnonzero(deform & leaf & ~np.isfinite(tails[:, 0])):
+        p = parents[j]
+        if p < 0 or parents[p] < 0 or j in targets:
+            continue
+        bone = heads[j] - heads[p]
+        length = np.linalg.norm(bone)
+        if length < 1e-12:
+            continue
+        for t in targets:
+            to = heads[t] - heads[j]
+            d = np.linalg.norm(to)
+            if 1e-12 < d <= reach * length and \
+                    to @ bone >= np.cos(np.radians(max_angle)) * d * length:
+                pairs.append((d, j, t))
+    used_j, used_t = set(), set()
+    for d, j, t in sorted(pairs):
+        if j not in used_j and t not in used_t:
+            tails[j] = heads[t]
+            used_j.add(j)
+            used_t.add(t)
     return tails
