@@ -153,9 +153,9 @@ def infer_leaf_tails(skeleton, deform, vertices, nearest_owner, rays=None, tails
 
 def branch_tails(skeleton, deform, tails):
     """One tail for each deforming joint with several children and no tail of its own:
-    toward the centroid of the children, as long as the nearest child is far (Blender's
-    glTF importer's bone, without its snap to the local axes); otherwise such a joint owns
-    a segment to each child.
+    toward the centroid of the children, as long as the nearest child is from the joint
+    (Blender's glTF importer's bone, without its snap to the local axes). Without it such a
+    joint owns a segment to each child.
 
     Parameters
     ----------
@@ -194,21 +194,10 @@ def ik_chain_tails(skeleton, deform, tails, max_angle=60.0, reach=3.0):
     shins went 0.69 to the foot target; the artist gave them 0.94 to the lower leg).
 
     A tail-less deforming leaf ``L`` whose parent is not a root takes as its tail the head of
-    the nearest *target*: a leaf whose parent is a root, not ``L``'s own root chain's
-    ancestor, within ``reach`` times ``L``'s parent bone and within ``max_angle`` degrees of
-    that bone's direction. Each target serves one leaf (the nearest).
-
-    Parameters
-    ----------
-    skeleton : Skeleton
-    deform : (J,) bool
-    tails : (J, 3) float64
-        NaN rows where a joint has no tail.
-
-    Returns
-    -------
-    tails : (J, 3) float64
-        A copy with those tails filled in.
+    the nearest *target*: another leaf whose parent is a root, within ``reach`` times the
+    length of ``L``'s parent bone and within ``max_angle`` degrees of that bone's direction.
+    Each target serves one leaf (the nearest). Parameters and result as for
+    :func:`branch_tails`.
     """
     heads = skeleton.bind_matrices[:, :3, 3]
     parents = skeleton.parents
