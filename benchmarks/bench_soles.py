@@ -1,6 +1,6 @@
 """Feet on the floor, measured on the skin: retargets and auto-rigged template clips.
 
-    .venv/bin/python benchmarks/bench_soles.py [--markdown] [--no-autorig]
+    .venv/bin/python benchmarks/bench_soles.py [--markdown] [--no-autorig] [--library]
 
 For each case the clip is retargeted with :func:`rigedit.rigging.retarget_result` twice:
 "before" with the skin step (:func:`rigedit.rigging.soles.hold_soles`) replaced by a
@@ -24,7 +24,8 @@ point in the target's calibration pose, its rest):
 Cases: the Bandai walk and CMU 131_01 onto the bundled humanoid, CesiumMan and Xbot; the
 bundled humanoid's and quadruped's own clips onto themselves; the shared homer.obj and cow.obj
 auto-rigged (``rigedit.autorig(..., clips=False)``, then each template clip retargeted, as
-the auto-rigging does).
+the auto-rigging does). ``--library``: instead, every clip of ``bvh-library/`` (Bandai
+dataset-2, the iClone rig) onto the three humanoid targets.
 """
 from __future__ import annotations
 
@@ -76,11 +77,18 @@ def run(source, clip, target):
     return before, measure(res, target, source), dt, len(res.times)
 
 
-def cases(autorig=True):
+def cases(autorig=True, library=False):
+    sources = dict(SOURCES)
+    if library:
+        sources = {f"{p.parent.name}/{p.stem}": p
+                   for p in sorted((DATA / "bvh-library").glob("*/*.bvh"))}
     for tname, tpath in TARGETS.items():
         target = rigedit.load_rig(tpath)
-        for sname, spath in SOURCES.items():
-            yield sname, tname, rigedit.load_rig(spath), "take", target
+        for sname, spath in sources.items():
+            source = rigedit.load_rig(spath)
+            yield sname, tname, source, next(iter(source.clips)), target
+    if library:
+        return
     for name in ("humanoid", "quadruped"):
         rig = rigedit.load_rig(name)
         for clip in sorted(rig.clips):
@@ -104,7 +112,8 @@ def main():
             "slip before mm (mean/max)", "slip after mm (mean/max)", "contacts", "time s",
             "CPU s"]
     rows = []
-    for sname, tname, source, clip, target in cases("--no-autorig" not in sys.argv):
+    for sname, tname, source, clip, target in cases("--no-autorig" not in sys.argv,
+                                                     "--library" in sys.argv):
         b, a, dt, n = run(source, clip, target)
         mm = lambda x: f"{1000 * x:.1f}"  # noqa: E731
         rows.append([sname, tname, str(n), mm(a["floor"]), mm(b["lowest"]), mm(a["lowest"]),

@@ -11,15 +11,18 @@ character stands on its floor, as the joint clean-up assumes).
 Skinning only heights is cheap: a vertex's linear-blend position is linear in its *lifted*
 vector ``z = (w_u [v, 1])_u`` over the U joints the feet use, so the heights of N vertices
 in F frames are one (N, 4U) x (4U, F) matrix product (Xbot's 3,574 foot vertices over CMU
-131_01's 994 frames: a few hundredths of a second).
+131_01's 994 frames: a few hundredths of a second; heights are kept in float32).
 
-:func:`hold_soles` then corrects the cleaned-up motion: each foot's lowest skinned point
-lies on the floor during the foot's contacts and never below it, and the point bearing the
-weight does not slide. The ankle's IK goal moves by the difference (the foot keeps its model
-rotation, so its skin moves with the ankle), blended over the contact's fade
-(:func:`rigedit.rigging.contacts.ramp`); outside contacts a sole below the floor is lifted
-(the lift spread over the same window so a swing does not jolt); where a leg cannot reach
-its goal the hips drop (:func:`rigedit.rigging.contacts.solve_legs`).
+:func:`hold_soles` then corrects the cleaned-up motion. A foot *stands* in the frames of a
+contact where the source's foot stands (:func:`standing`, on the source's skin when it has
+one: :func:`source_clearance`); there its lowest skinned point goes onto the floor and the
+patch it stands on does not slide (:func:`hold_offsets`), both changes faded in and out as
+the joints' pins are (:func:`fade_runs`); in every other frame a sole below the floor is
+lifted. Where every foot on the ground must rise (or sink) the body does, by the least of
+them (:func:`raise_body`); the rest moves each ankle's IK goal (the foot keeps its model
+rotation, so the skin it carries moves with the ankle; where the shin carries part of it a
+measured gain per frame makes up the difference), the hips dropping where a leg cannot
+reach (:func:`rigedit.rigging.contacts.solve_legs`).
 
 Pure numpy + scipy.
 """
@@ -36,8 +39,7 @@ from .contacts import blend_frames, ramp, runs, smooth_max, solve_legs
 
 __all__ = ["Soles", "find_soles", "skin_points", "vertex_heights", "sole_heights",
            "bearing_steps", "sole_slip", "hold_offsets", "fade_runs", "source_clearance",
-           "foot_legs",
-           "standing_heights", "raise_body", "hold_soles", "sole_measures",
+           "foot_legs", "standing", "raise_body", "hold_soles", "sole_measures",
            "DOMINANT", "TOLERANCE", "STANDING", "PATCH"]
 
 #: A vertex belongs to a foot when at least this much of its weight is on the foot's joints.
@@ -360,35 +362,27 @@ def foot_legs(tgt, contact, clearance=None):
     return [(leg.upper, leg.knee, leg.ankle) for leg in tgt.legs], contact, clearance
 
 
-def standing_heights(clearance, contact, blend, tol):
-    """The height a foot's sole keeps during each of its contacts: 0 while the source's
-    foot stands within ``tol`` of the lowest it stands in that contact (mocap feet wobble by
-    millimetres while they bear the weight), above that by as much more as the source's
-    rises (a foot that the contact's tolerance still counts while it lifts, or sets down,
-    lifts and sets down as the source's does, a little later). In the ``blend`` frames
-    either side of a contact, relative to that contact's lowest too.
+def standing(clearance, contact, tol):
+    """The frames a foot stands in: those of its contacts in which the source's foot stands
+    within ``tol`` of the lowest it stands in that contact (mocap feet wobble by millimetres
+    while they bear the weight; the contact's own tolerance also counts the first lift of a
+    foot, or its setting down, which are not standing).
 
     Parameters
     ----------
-    clearance, contact : (F,) float64, (F,) bool
-    blend : int
+    clearance : (F,) float64
+        :func:`source_clearance` of the foot.
+    contact : (F,) bool
     tol : float
 
     Returns
     -------
-    heights : (F,) float64
-        Never below 0; the foot *stands* where it is 0 in a contact.
+    standing : (F,) bool
     """
-    n = len(contact)
-    base = np.full(n, np.nan)
+    out = np.zeros(len(contact), dtype=bool)
     for a, b in runs(contact):
-        base[a:b] = clearance[a:b].min()
-    for a, b in runs(contact):
-        for k in range(1, blend + 1):
-            for f in (a - k, b - 1 + k):
-                if 0 <= f < n and np.isnan(base[f]):
-                    base[f] = base[a]
-    return np.maximum(0.0, clearance - np.nan_to_num(base) - tol)
+        out[a:b] = clearance[a:b] <= clearance[a:b].min() + tol
+    return out
 
 
 def _onto_floor(low, held, blend):
@@ -461,8 +455,8 @@ def hold_soles(rig, tgt, rot, hips_pos, mats, contact, clearance, times, mapped,
         See :func:`foot_legs`.
     clearance : (F, P) float64 or None
         :func:`source_clearance`: during a contact the sole stands on the floor while the
-        source's foot stands, and lifts as the source's lifts (:func:`standing_heights`);
-        None holds it on the floor throughout.
+        source's foot stands (:func:`standing`), and is free while the source lifts it; None
+        holds it on the floor throughout.
     times : (F,) float64
     mapped : dict or set
         Target joints the map reaches (others below a leg's top keep their rest pose).
@@ -481,11 +475,9 @@ def hold_soles(rig, tgt, rot, hips_pos, mats, contact, clearance, times, mapped,
         return rot, hips_pos, mats
     blend = blend_frames(times)
     tol = TOLERANCE * tgt.hip_height
-    stand = np.stack([standing_heights(clear[:, i], touch[:, i], blend,
-                                       STANDING * tgt.hip_height)
-                      for i in range(len(legs))], axis=1)
     # the frames a foot stands in: contacts, less those in which the source lifts it
-    held = touch & (stand == 0)
+    held = np.stack([standing(clear[:, i], touch[:, i], STANDING * tgt.hip_height)
+                     for i in range(len(legs))], axis=1)
     w = np.stack([ramp(held[:, i], blend) for i in range(len(legs))], axis=1)
     rot, hips_pos = rot.copy(), np.array(hips_pos, dtype=np.float64)
     y = vertex_heights(soles, sk, mats)
@@ -562,8 +554,8 @@ def sole_measures(result, rig, source_rig=None):
     dict
         ``lowest``: the lowest sole point over the clip above the floor (negative: below);
         ``below``: the share of frames in which a sole is more than 1 mm below it;
-        ``standing``: the sole's height in the worst standing frame of a contact (where the
-        source's foot stands: :func:`standing_heights` is 0), signed; ``slips``: (C,) slip
+        ``standing``: the sole's height in the worst standing frame of a contact
+        (:func:`standing`), signed; ``slips``: (C,) slip
         per contact over its standing frames (:func:`sole_slip`); ``floor``: the floor's
         model y. Lengths in model units.
     """
@@ -576,13 +568,12 @@ def sole_measures(result, rig, source_rig=None):
     y = vertex_heights(soles, rig.skeleton, result.mats)
     low = sole_heights(soles, rig.skeleton, result.mats, y) - soles.floor
     steps = bearing_steps(soles, rig.skeleton, result.mats, y)
-    standing, slips = 0.0, []
+    worst_stand, slips = 0.0, []
     for i in range(len(legs)):
-        stand = touch[:, i] & (standing_heights(clear[:, i], touch[:, i], 0,
-                                                STANDING * tgt.hip_height) == 0)
+        stand = standing(clear[:, i], touch[:, i], STANDING * tgt.hip_height)
         if stand.any():
             worst = low[stand, i][np.argmax(np.abs(low[stand, i]))]
-            standing = worst if abs(worst) > abs(standing) else standing
+            worst_stand = worst if abs(worst) > abs(worst_stand) else worst_stand
             slips.extend(sole_slip(steps[:, i], stand))
     return dict(lowest=float(low.min()), below=float((low < -1e-3).any(axis=1).mean()),
-                standing=float(standing), slips=np.array(slips), floor=soles.floor)
+                standing=float(worst_stand), slips=np.array(slips), floor=soles.floor)
