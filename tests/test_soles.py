@@ -226,3 +226,15 @@ def test_soles_left_off_the_floor_are_reported(quadruped):
     with mock.patch("rigedit.rigging.soles.ROUNDS", 1):
         with pytest.warns(UserWarning, match=r"skinned soles stay up to [0-9.]+ mm off"):
             retarget_result(quadruped, "walk", target)
+
+
+def test_a_target_without_a_binding_keeps_the_joints(humanoid):
+    """The editor's import hands the retarget a snapshot of the skeleton and clips only:
+    no skin to measure, so the joints' clean-up stands (no error)."""
+    from types import SimpleNamespace
+
+    snap = SimpleNamespace(skeleton=humanoid.skeleton, clips=dict(humanoid.clips))
+    res = retarget_result(humanoid, "walk", snap)
+    with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
+        joints = retarget_result(humanoid, "walk", snap)
+    np.testing.assert_array_equal(res.mats, joints.mats)

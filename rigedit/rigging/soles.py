@@ -95,12 +95,19 @@ class Soles:
         return np.r_[0, np.cumsum([len(v) for v in self.vertices])]
 
 
+def _has_skin(rig):
+    binding = getattr(rig, "binding", None)
+    return binding is not None and binding.num_vertices > 0
+
+
 def find_soles(rig, feet, calibration_mats, what="target"):
     """The feet of ``rig`` on its skin, or None for a rig without a mesh.
 
     Parameters
     ----------
     rig : Rig
+        Or anything with its ``skeleton`` and ``binding`` (a :class:`SkinBinding`); one
+        without a binding (the editor's snapshot of a skeleton and clips) has no skin here.
     feet : list of int
         The ankle joint of each foot; the foot is its subtree.
     calibration_mats : (J, 4, 4) float64
@@ -114,7 +121,7 @@ def find_soles(rig, feet, calibration_mats, what="target"):
         None (with a warning naming the joint) also when some foot dominates no vertex:
         then the feet are kept on the floor by their joints, as the skin cannot say.
     """
-    if len(rig.vertices) == 0:
+    if not _has_skin(rig):
         return None
     sk, binding = rig.skeleton, rig.binding
     weights = sp.csr_matrix(binding.matrix, dtype=np.float64)
@@ -313,7 +320,7 @@ def source_clearance(src, smats, s_floor, s_points, scale, source_rig=None):
     """
     rest = src.mats[s_points, 1, 3] - src.joint_floor
     joints = scale * (smats[:, s_points, 1, 3] - s_floor - rest[None])
-    if source_rig is None or len(source_rig.vertices) == 0:
+    if not _has_skin(source_rig):
         return joints
     if src.kind == "humanoid":
         ankles = [src.slots["foot_L"], src.slots["foot_R"]] * 2
