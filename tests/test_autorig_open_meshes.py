@@ -326,3 +326,49 @@ def test_robot_of_node_parts_is_read_whole():
     rig = _autorig(path, up="y", forward="z")
     assert len(rig.vertices) == len(v)
     assert any(x.startswith("proxy: ") for x in rig.autorig_report.lines())
+
+
+def _static_gltf(path, parts):
+    """A .gltf with no skin: one mesh node per (vertices, faces, translation) part, the
+    buffer embedded as a data URI."""
+    import base64
+    import json
+
+    blobs, accessors, views, meshes, nodes = b"", [], [], [], []
+    for i, (v, f, t) in enumerate(parts):
+        for arr, target, kind, ctype in ((np.asarray(v, np.float32), 34962, "VEC3", 5126),
+                                         (np.asarray(f, np.uint32).ravel(), 34963, "SCALAR",
+                                          5125)):
+            data = arr.tobytes()
+            views.append({"buffer": 0, "byteOffset": len(blobs), "byteLength": len(data),
+                          "target": target})
+            acc = {"bufferView": len(views) - 1, "componentType": ctype,
+                   "count": len(arr), "type": kind}
+            if kind == "VEC3":
+                acc.update(min=arr.min(0).tolist(), max=arr.max(0).tolist())
+            accessors.append(acc)
+            blobs += data + b"\0" * (-len(data) % 4)
+        meshes.append({"primitives": [{"attributes": {"POSITION": 2 * i}, "indices": 2 * i + 1}]})
+        nodes.append({"mesh": i, "translation": list(map(float, t))})
+    doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}],
+           "nodes": nodes, "meshes": meshes, "accessors": accessors, "bufferViews": views,
+           "buffers": [{"byteLength": len(blobs), "uri": "data:application/octet-stream;base64,"
+                        + base64.b64encode(blobs).decode()}]}
+    path.write_text(json.dumps(doc))
+
+
+def test_static_gltf_is_read_whole_where_its_nodes_place_it(tmp_path, human):
+    from rigedit.rigging.mesh_check import read_mesh
+
+    v, f = human.vertices, human.faces
+    box, box_f = _box_shell((-0.1, 0.0, -0.1), (0.1, 0.2, 0.1))
+    path = tmp_path / "static.gltf"
+    _static_gltf(path, [(v, f, (0.0, 0.0, 0.0)), (box, box_f, (0.0, 2.0, 0.0))])
+    got_v, got_f = read_mesh(path)
+    assert len(got_v) == len(v) + len(box) and len(got_f) == len(f) + len(box_f)
+    assert np.allclose(got_v[len(v):], box + (0.0, 2.0, 0.0), atol=1e-6)   # moved by its node
+    assert np.allclose(got_v[:len(v)], v, atol=1e-6)
+    # the character alone rigs (before, a glTF without a skin was refused)
+    _static_gltf(path, [(v, f, (0.0, 0.0, 0.0))])
+    rig = _autorig(path, up="y", forward="z")
+    assert _cd_to_truth(rig, human.skeleton, list(human.skeleton.names[1:])) < 1.0

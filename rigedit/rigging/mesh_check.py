@@ -184,6 +184,12 @@ def _gltf_meshes(data, meshed):
                 w = w / np.maximum(w.sum(axis=1, keepdims=True), 1e-12)
                 blend = np.einsum("vk,vkij->vij", w, palette[np.clip(j, 0, len(palette) - 1)])
                 placed = np.einsum("vij,vj->vi", blend, h)
+            if not np.all(np.isfinite(placed)):
+                raise RigFileError(data.path, f"mesh {node.mesh}: expected finite vertex "
+                                              "positions once placed, got NaN or inf")
+            if idx.size and (idx.min() < 0 or idx.max() >= len(pos)):
+                raise RigFileError(data.path, f"mesh {node.mesh}: expected indices below "
+                                              f"{len(pos)} vertices, got {idx.max()}")
             verts.append(placed[:, :3])
             faces.append(triangles(idx, mode) + offset)
             offset += len(pos)
