@@ -43,7 +43,7 @@ def test_hinted_joints_are_where_the_user_put_them_and_help_the_others(humanoid,
     others = [j for j in pick if sk.names[j] not in names]
     before = cd_j2j(free.positions[others], truth[others], diag)
     after = cd_j2j(pinned.positions[others], truth[others], diag)
-    assert after < 0.8 * before, (before, after)
+    assert after < 0.8 * before, (before, after)   # measured 4.16% -> 2.84%
 
 
 def test_hinted_knees_keep_the_feet_where_the_mesh_has_them(humanoid, crouched):
@@ -59,7 +59,7 @@ def test_hinted_knees_keep_the_feet_where_the_mesh_has_them(humanoid, crouched):
         assert np.allclose(emb.positions[sk.index[n]], hints[n])
     for n in ("LeftFoot", "RightFoot"):
         j = sk.index[n]
-        assert np.linalg.norm(emb.positions[j] - truth[j]) / diag < 0.04, n  # measured 0.023
+        assert np.linalg.norm(emb.positions[j] - truth[j]) / diag < 0.04, n  # measured 0.029
 
 
 def test_an_unknown_joint_is_one_error_naming_it(humanoid):

@@ -22,6 +22,7 @@ from .legs import LEG_TOP, leg_top_heights, lower_leg_tops, template_leg_top
 from .medial import medial_cells, pack_spheres
 from .place import place_carried, place_chains
 from .search import discrete_embedding
+from .tails import extend_tails
 from .template import reduce_template
 
 __all__ = ["Embedding", "EmbeddingError", "HintError", "embed_skeleton"]
@@ -216,6 +217,7 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None,
             f"embedding costs {found.cost:.0f}, a fitting one under "
             f"{MAX_COST_PER_BONE * max(len(reduced.joints) - 1, 1):.0f} (is the mesh a blob "
             "without limbs, or posed far from the template?)")
+    found.vertex = extend_tails(graph, reduced, found.vertex)
     positions = np.full((len(reduced.joints), 3), np.nan)
     ok = found.vertex >= 0
     positions[ok] = graph.points[found.vertex[ok]]
@@ -225,7 +227,7 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None,
         if j in pins and ok[r]:
             positions[r] = pins[j]
     hold = W_SCALE_FIRM if np.isfinite(reduced.height) else W_SCALE_WEAK
-    chains = _pin(place_chains(reduced, positions, paths), pins)
+    chains = _pin(place_chains(reduced, positions, paths, scale=scale), pins)
     out, scale = stage("refinement", 0.95, fit_joints, field_, reduced, chains, scale,
                        frame["floor"], hold, graph.points, frame["plane_x"], pins)
     # a deep trunk lifts the hips' sphere centre: the thighs go where the legs part (not

@@ -56,6 +56,9 @@ W_FEET = 1.0
 #: Chains keep the template's proportions unless the embedded chord differs by more than
 #: this (log ratio, ~16%); beyond it they take the excess (see ``_proportions``).
 PROPORTION_FREE = 0.15
+#: A tail's chain may take from a quarter to four times the template's length (a pug's
+#: stub, a horse's tail): other chains stay within 0.6-1.6 of theirs.
+TAIL_RANGE = (0.25, 4.0)
 #: Weight pulling a joint that left the mesh back to the nearest medial point.
 W_INSIDE = 10.0
 #: Left-right symmetry, per coordinate: half a bone's weight, so that an asymmetric pose
@@ -128,7 +131,11 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
     pb = np.array([slot[p] for p, _ in bones])
     cb = np.array([slot[j] for _, j in bones])
     tb = np.array([rest[j] - rest[p] for p, j in bones])
-    tb *= _proportions(template, positions, scale)[[owner[j] for _, j in bones]][:, None]
+    factor = _proportions(template, positions, scale)[[owner[j] for _, j in bones]]
+    if template.tail is not None:   # a tail's first bone (base to tail root) keeps its length
+        roots = {template.chains[r][1] for r in np.flatnonzero(template.tail)}
+        factor[[i for i, (_, j) in enumerate(bones) if j in roots]] = 1.0
+    tb *= factor[:, None]
     span = np.ptp(rest[idx, 1])
     # feet: (slot, template height above the template's ground)
     low = rest[idx, 1] - template.floor
@@ -182,7 +189,8 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
 
 def _proportions(template, positions, scale):
     """(R,) length factor of each reduced chain: its embedded chord over the scaled template
-    chord, outside a dead zone of +-``PROPORTION_FREE`` (log) and clipped to [0.6, 1.6].
+    chord, outside a dead zone of +-``PROPORTION_FREE`` (log) and clipped to [0.6, 1.6]
+    (a tail: from its root joint, within ``TAIL_RANGE``).
 
     The discrete embedding puts chain ends where the mesh has them (hands at the ends of
     arms); a character whose arms or legs are much shorter or longer than the template's
@@ -191,13 +199,15 @@ def _proportions(template, positions, scale):
     rest = template.rest
     out = np.ones(len(template.joints))
     for r in range(1, len(template.joints)):
-        a, b = template.chains[r][0], template.chains[r][-1]
+        tail = template.tail is not None and template.tail[r] and len(template.chains[r]) > 2
+        a, b = template.chains[r][1 if tail else 0], template.chains[r][-1]
         if np.all(np.isfinite(positions[[a, b]])):
             ratio = np.linalg.norm(positions[b] - positions[a]) / max(
                 scale * np.linalg.norm(rest[b] - rest[a]), 1e-12)
             excess = np.log(max(ratio, 1e-12))
             excess = np.sign(excess) * max(abs(excess) - PROPORTION_FREE, 0.0)
-            out[r] = np.clip(np.exp(excess), 0.6, 1.6)
+            lo, hi = TAIL_RANGE if tail else (0.6, 1.6)
+            out[r] = np.clip(np.exp(excess), lo, hi)
     return out
 
 

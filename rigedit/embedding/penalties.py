@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["bone_costs", "joint_costs", "mirror_cost", "W_CARRY", "SEPARATE_RATIO"]
+__all__ = ["bone_costs", "joint_costs", "mirror_cost", "W_CARRY", "SEPARATE_RATIO",
+           "W_LENGTH_TAIL"]
 
 #: Bone length, as twice the (log ratio)^2 of the chord to the template chord (times the
 #: scale): a bone 25% too long or short costs 0.1, half or twice as long ~1. Weak on
@@ -22,6 +23,11 @@ __all__ = ["bone_costs", "joint_costs", "mirror_cost", "W_CARRY", "SEPARATE_RATI
 #: cartoon's short legs), and a stronger length term made the search fold a cow's body to
 #: the elk's length, hind legs in the front legs.
 W_LENGTH = 1.0
+#: The length term of a tail's bone (see ``template._tails``) is this fraction of a limb's: a
+#: tail is a pug's stub or a horse's arc, so its length says little, while where the mesh's
+#: branch ends says much (the horse's tail end stopped half-way down its tail at the full
+#: weight, 8% of its size off the artist's).
+W_LENGTH_TAIL = 0.2
 #: Allowed excess of a path's detour (log of path over chord) over the template chain's.
 DETOUR = 0.15
 #: Bone direction, times (1 - cos) of the angle to the template chord: 0.9 for 45 degrees
@@ -50,7 +56,7 @@ W_CARRY = 0.5
 SEPARATE_RATIO = 1.4
 
 
-def bone_costs(points, dist, chord, chain_length, scale):
+def bone_costs(points, dist, chord, chain_length, scale, w_length=W_LENGTH):
     """(N, N) cost of a reduced bone from vertex a (rows) to vertex b (columns).
 
     Parameters
@@ -65,6 +71,9 @@ def bone_costs(points, dist, chord, chain_length, scale):
         Template length of the chain of bones it stands for.
     scale : float
         Mesh units per template unit.
+    w_length : float
+        Weight of the length term (``W_LENGTH``; ``W_LENGTH * W_LENGTH_TAIL`` for a
+        tail).
 
     Returns
     -------
@@ -79,8 +88,8 @@ def bone_costs(points, dist, chord, chain_length, scale):
         # chord only as much as the template chain is longer than its chord, give or take:
         # beyond that the bone wanders through another part (a hand reached via the hips).
         detour = np.log(dist / length) - np.log(chain_length / chord_len)
-        cost = W_LENGTH * (2.0 * np.log(length / (scale * chord_len)) ** 2
-                           + np.maximum(detour - DETOUR, 0.0) ** 2)
+        cost = w_length * 2.0 * np.log(length / (scale * chord_len)) ** 2
+        cost += W_LENGTH * np.maximum(detour - DETOUR, 0.0) ** 2
         cost += W_DIRECTION * (1.0 - cos)
     cost[~np.isfinite(cost)] = np.inf
     np.fill_diagonal(cost, np.inf)

@@ -38,7 +38,7 @@ def _along(polyline, fractions):
                      for d in range(3)], axis=1)
 
 
-def place_chains(template, reduced, paths=None, bend=0.75):
+def place_chains(template, reduced, paths=None, bend=0.75, scale=None):
     """Positions of the joints of the embedded chains (reduced joints and inner ones).
 
     Parameters
@@ -53,6 +53,9 @@ def place_chains(template, reduced, paths=None, bend=0.75):
         (a bent knee or elbow is where the medial path bends), not wholly (the path zigzags
         between sphere centres). 0.75 measured best of 0.5, 0.75 and 1 on the posed bundled
         characters and the Khronos figures (``benchmarks/bench_embedding.py``).
+    scale : float, optional
+        Mesh units per template unit: with it a tail's root joint keeps its scaled template
+        offset from the tail's base and only the tail's own bones spread along its path.
 
     Returns
     -------
@@ -75,10 +78,24 @@ def place_chains(template, reduced, paths=None, bend=0.75):
         rot = least_rotation(rest[b] - rest[a], out[b] - out[a])
         k = np.linalg.norm(out[b] - out[a]) / max(np.linalg.norm(rest[b] - rest[a]), 1e-12)
         mapped = out[a] + k * rot.apply(rest[inner] - rest[a])
-        if paths is not None and paths[r] is not None and len(paths[r]) > 2 and bend > 0:
+        path = paths[r] if paths is not None else None
+        if path is not None and len(path) > 2 and bend > 0:
             bones = np.linalg.norm(np.diff(rest[chain], axis=0), axis=1)
-            frac = np.cumsum(bones)[:-1] / max(bones.sum(), 1e-12)
-            mapped = (1.0 - bend) * mapped + bend * _along(paths[r], frac)
+            if scale is not None and template.tail is not None and template.tail[r] \
+                    and len(inner) > 1:
+                # a tail: its root stays where the template has it off its base (the body's
+                # edge), the rest spread along the path beyond it (a long tail stretches its
+                # own bones, not the base's)
+                mapped[0] = out[a] + scale * (rest[inner[0]] - rest[a])
+                start = int(np.argmin(np.linalg.norm(path - mapped[0], axis=1)))
+                path = np.concatenate([mapped[:1], path[start + 1:]])
+                if len(path) < 2:
+                    path = np.concatenate([mapped[:1], out[b][None]])
+                frac = np.cumsum(bones[1:])[:-1] / max(bones[1:].sum(), 1e-12)
+                mapped[1:] = (1.0 - bend) * mapped[1:] + bend * _along(path, frac)
+            else:
+                frac = np.cumsum(bones)[:-1] / max(bones.sum(), 1e-12)
+                mapped = (1.0 - bend) * mapped + bend * _along(path, frac)
         out[inner] = mapped
     return out
 

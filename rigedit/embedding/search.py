@@ -24,7 +24,8 @@ import numpy as np
 
 from .fit import FEET
 from .hints import hint_pair, hint_unary
-from .penalties import SEPARATE_RATIO, W_CARRY, bone_costs, joint_costs, mirror_cost
+from .penalties import (SEPARATE_RATIO, W_CARRY, W_LENGTH, W_LENGTH_TAIL, bone_costs,
+                        joint_costs, mirror_cost)
 
 __all__ = ["Search", "discrete_embedding"]
 
@@ -132,7 +133,8 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None,
     for k in np.flatnonzero(template.optional):
         unary[k, thin] = np.inf
     pair = [None] + [bone_costs(pts, dist, rest[k] - rest[parent[k]], template.chain_length[k],
-                                scale) for k in range(1, r)]
+                                scale, W_LENGTH * (W_LENGTH_TAIL if template.tail[k] else 1.0))
+                     for k in range(1, r)]
     unit = 0.05 * template.size * scale
     for j, point in (hints or {}).items():
         if j in template.joints:

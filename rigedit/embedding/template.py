@@ -26,6 +26,8 @@ __all__ = ["ReducedTemplate", "reduce_template", "SHORT", "REQUIRED"]
 
 SHORT = 0.1
 REQUIRED = 0.5
+#: Joints of a middle-plane tip chain that make it a tail (see ``_tails``).
+TAIL_JOINTS = 3
 #: Height of a standing template's lowest embedded joints (ankles, hooves) above its ground,
 #: as a fraction of the embedded joints' height span: about 6% on the bundled characters,
 #: CesiumMan and RiggedFigure alike. A template does not say where its ground is (a BVH's
@@ -67,6 +69,8 @@ class ReducedTemplate:
         Template joints never embedded.
     mirror_all : (J,) int
         Every template joint's mirror image (-1: none; -2: on the middle plane).
+    tail : (R,) bool
+        The reduced joint ends a tail (see ``_tails``): optional, its length weakly held.
     """
 
     rest: np.ndarray
@@ -83,6 +87,7 @@ class ReducedTemplate:
     mirror: np.ndarray
     carried: np.ndarray
     mirror_all: np.ndarray = None
+    tail: np.ndarray = None
 
     def label(self, skeleton, r):
         """A human name for reduced joint ``r``'s chain ("left arm (LeftHand)")."""
@@ -143,6 +148,8 @@ def reduce_template(skeleton, mesh=None):
     for j in range(n):
         p = parents[j]
         tip[j] = p >= 0 and (tip[p] or bone[j] + reach[j] < SHORT * size)
+    tails = _tails(rest, parents, tip, size)
+    tip &= ~tails
     # a root is carried when it does not deform (a ground-level "root" joint)
     carried = tip | ((parents < 0) & ~deform)
     kept = np.flatnonzero(~carried)
@@ -190,12 +197,41 @@ def reduce_template(skeleton, mesh=None):
         floor, height = float(verts[:, 1].min()), float(np.ptp(verts[:, 1]))
         area = surface_area(verts, mesh[1])
     return ReducedTemplate(rest, parents.copy(), size, floor, height, area, np.asarray(reduced),
-                           parent, chains, length, optional, mirror, carried, mirror_all)
+                           parent, chains, length, optional, mirror, carried, mirror_all,
+                           tails[reduced] & optional)
 
 
 def surface_area(vertices, faces):
     """Total area of a triangle mesh."""
     return float(face_areas(vertices, faces).sum())
+
+
+def _tails(rest, parents, tip, size):
+    """(J,) bool: short tip chains that are tails, to embed (as optional branches) rather
+    than carry.
+
+    A tail is an unbranched chain of at least ``TAIL_JOINTS`` joints on the middle plane,
+    hanging from a joint that is not a tip. Tails vary most between characters (a pug's
+    stub, a horse's long arc) and a mesh shows them well; carried at the template's length,
+    the Quaternius horse's four tail joints sat 3.5-6.9% of its size off its artist's. A jaw
+    (one joint), ears and antlers (off the plane) stay carried.
+    """
+    n = len(parents)
+    root_x = rest[np.flatnonzero(parents < 0)[0], 0] if (parents < 0).any() else 0.0
+    children = [np.flatnonzero(parents == j) for j in range(n)]
+    out = np.zeros(n, dtype=bool)
+    for j in range(n):
+        p = parents[j]
+        if not tip[j] or p < 0 or tip[p]:
+            continue
+        chain = [j]
+        while len(children[chain[-1]]) == 1:
+            chain.append(int(children[chain[-1]][0]))
+        if len(children[chain[-1]]) or len(chain) < TAIL_JOINTS:
+            continue
+        if np.all(np.abs(rest[chain, 0] - root_x) < 0.02 * size):
+            out[chain] = True
+    return out
 
 
 def _optional(parent, length):
