@@ -340,3 +340,48 @@ def test_api_retarget_returns_a_clip_of_the_target(humanoid):
     assert abs(clip.duration - _load(RUN).clips["take"].duration) < 1e-9
     moving = [j for (j, ch) in clip.tracks if ch == "rotation"]
     assert {"LeftUpLeg", "RightLeg", "LeftArm", "Spine2", "Head"} <= set(moving)
+
+
+def _with_joints(skeleton, extra, rest_rotation=None):
+    """``skeleton`` with joints ``[(name, parent name, offset)]`` appended (identity rest
+    rotations), and optionally other rest rotations for its own joints."""
+    names = list(skeleton.names) + [e[0] for e in extra]
+    index = {n: i for i, n in enumerate(names)}
+    parents = list(skeleton.parents) + [index[e[1]] for e in extra]
+    trans = np.r_[skeleton.rest_translation, [e[2] for e in extra]]
+    rot = np.r_[skeleton.rest_rotation if rest_rotation is None else rest_rotation,
+                np.tile([0.0, 0.0, 0.0, 1.0], (len(extra), 1))]
+    scale = np.r_[skeleton.rest_scale, np.ones((len(extra), 3))]
+    return Skeleton(names, parents, trans, rot, scale)
+
+
+def test_unmapped_target_joints_keep_the_calibration_pose_not_a_lying_rest(humanoid):
+    """A target whose rest lies down (as Bandai's and iClone's do) is calibrated on its
+    clip's first frame; an unmapped joint (a face joint between the head and a mapped eye)
+    must keep its relation to its parent in that frame: kept at rest, it turned the head's
+    bone (head to eye) 85 degrees off on the iClone rig."""
+    sk = humanoid.skeleton
+    src_sk = _with_joints(sk, [("LeftEye", "Head", (0.03, 0.07, 0.10))])
+    src = Rig(src_sk, np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64),
+              clips={"walk": _rebound(humanoid.clips["walk"], src_sk)})
+    lying = sk.rest_rotation.copy()
+    lying[sk.index["root"]] = Rotation.from_euler("x", 90, degrees=True).as_quat()
+    tgt_sk = _with_joints(sk, [("Face", "Head", (0.0, 0.05, 0.05)),
+                               ("LeftEye", "Face", (0.03, 0.02, 0.05))], lying)
+    from rigedit.animation.clip import Clip, Track
+    stand = {("root", "rotation"): Track("rotation", [0.0], [[0.0, 0.0, 0.0, 1.0]]),
+             ("Face", "rotation"): Track("rotation", [0.0], [Rotation.from_euler(
+                 "x", 30, degrees=True).as_quat()])}
+    tgt = Rig(tgt_sk, np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64),
+              clips={"stand": Clip("stand", tgt_sk, stand, duration=0.0)})
+    res = retarget_result(src, "walk", tgt, clean_feet=False)
+    assert res.target_calibration.source == "frame 0 of stand"
+    assert res.mapping["LeftEye"] == "LeftEye" and "Face" not in res.mapping.values()
+    raw = direction_errors(res, res.raw_mats)
+    assert max(raw[g] for g in ("arms", "legs", "spine", "head")) < 0.01, raw
+
+
+def _rebound(clip, skeleton):
+    from rigedit.animation.clip import Clip
+
+    return Clip(clip.name, skeleton, dict(clip.tracks), duration=clip.duration, loop=clip.loop)

@@ -67,7 +67,12 @@ def transfer_rotations(src, tgt, inverse, smats, scal, rf, contact):
         if humanoid else []
     n_frames, nj = len(smats), len(tsk)
     rot = np.empty((n_frames, nj, 3, 3))
-    rest_rot = Rotation.from_quat(tsk.rest_rotation).as_matrix()
+    # an unmapped joint keeps its relation to its parent in the target's calibration pose:
+    # the rest's when the rest stands, else that of the clip frame calibrated on (iClone's and
+    # Bandai's rests point every bone along one axis: their faces, kept at rest, turned the
+    # head's bone to an eye 85 degrees off)
+    keep = [t_rot_c[j] if tsk.parents[j] < 0 else t_rot_c[tsk.parents[j]].T @ t_rot_c[j]
+            for j in range(len(tsk))]
     # feet and toes: pitch relative to each figure's flat foot, not the same direction (a
     # BVH foot often points more steeply down than a mesh's: copied, the toes would dig in)
     flat = {tgt.slots[f"{part}_{side}"]: contact[:, k] & contact[:, k + 2]
@@ -78,7 +83,7 @@ def transfer_rotations(src, tgt, inverse, smats, scal, rf, contact):
     for j in range(nj):
         p = tsk.parents[j]
         if j not in inverse:
-            rot[:, j] = (rot[:, p] if p >= 0 else np.eye(3)) @ rest_rot[j]
+            rot[:, j] = (rot[:, p] if p >= 0 else np.eye(3)) @ keep[j]
             continue
         s = inverse[j]
         nxt = chain[chain.index(j) + 1] if j in chain and j != chain[-1] else None
