@@ -11,6 +11,7 @@ figure before it).
 """
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -125,6 +126,20 @@ SHARED = {"khronos-gltf/CesiumMan.glb": ("humanoid", KHRONOS["CesiumMan.glb"]),
           "khronos-gltf/RiggedFigure.glb": ("humanoid", KHRONOS["RiggedFigure.glb"]),
           "threejs-characters/Xbot.glb": ("humanoid", MIXAMO),
           "quaternius-farm-animals/Horse.gltf": ("quadruped", HORSE)}
+
+
+#: Joints RigNet's CD-J2J leaves out of the truth, as the issue measures it: fingers and end
+#: markers (``HeadTop_End``, ``LeftToe_End``).
+LEFT_OUT = re.compile(r"thumb|index|middle|ring|pinky|finger|_end$", re.IGNORECASE)
+
+
+def full_truth(path):
+    """Every artist joint of a shared character at rest but fingers and end markers (the
+    truth of the issue's CD-J2J, against every template joint: no name table)."""
+    rig = rigedit.load_rig(str(DATA / path))
+    joints = rig.joint_matrices(rig.rest_pose())[:, :3, 3]
+    keep = [j for j, n in enumerate(rig.skeleton.names) if not LEFT_OUT.search(n)]
+    return joints[keep]
 
 
 def shared_case(path, template):
