@@ -126,8 +126,9 @@ def test_cli_hint_options(tmp_path, capsys, humanoid):
     common = ["--up", "y", "--forward", "z", "--method", "idw", "--no-clips", "-q", "-o"]
     code = main(["autorig", str(mesh), "--hint", f"LeftHand={hand[0]},{hand[1] + 0.02},"
                  f"{hand[2]}"] + common + [str(out)])
-    assert code == 0, capsys.readouterr().err
-    capsys.readouterr()
+    out_text, err = capsys.readouterr()
+    assert code == 0, err
+    assert "hints: LeftHand pinned where given" in out_text
     # bad hints: one line naming the joint (or the option, or the file), nothing written
     cases = [(["--hint", "LeftElbow=0.5,1.4,0"], "'LeftElbow'"),
              (["--hint", "Head=0,9,0"], "'Head' is outside the mesh"),

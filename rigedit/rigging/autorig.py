@@ -127,6 +127,8 @@ class AutorigReport:
             out.append("orientations tried: " + "; ".join(self.orientations))
         out.append(f"embedding: template {self.template} ({self.template_pose} pose), "
                    f"{len(self.placed)} joints placed from the mesh, cost {self.cost:.4g}")
+        if self.hints:
+            out.append("hints: " + ", ".join(sorted(self.hints)) + " pinned where given")
         out += [f"NOT SURE: {reason}" for reason in self.reasons]
         out.append("checks: " + ("all passed (limbs, upright, mirror, inside, lengths, "
                                  "margin)" if self.sure else
