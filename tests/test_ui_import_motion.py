@@ -77,6 +77,14 @@ def test_import_bandai_walk_adds_one_moving_clip_as_one_undo_step(humanoid_windo
     assert 10 <= mapped <= len(doc.skeleton)
     assert f"{len(doc.skeleton) - mapped} of this character's joints unmapped" in msg
     assert "joint map automatic" in msg
+    # the editor's import is the headless retarget onto the same character, skin included:
+    # its soles are held on the skinned feet, not on the ankle joints (a target snapshot
+    # without the binding fell back to the joints and gave another clip)
+    headless = rigedit.retarget(_load(WALK), "take", doc.rig, name=name)
+    for t in np.linspace(0, clip.duration, 7):
+        a, b = clip.sample(t), headless.sample(t)
+        assert np.allclose(a.translation, b.translation, atol=1e-6)
+        assert np.allclose(a.rotation, b.rotation, atol=1e-6)
 
     added = clip
     doc.undo()

@@ -96,8 +96,11 @@ class ImportMotion:
         # the job reads a snapshot of the clips: the user may edit them meanwhile
         ctx = SimpleNamespace(path=path, source=source, clip=name, rig=doc.rig,
                               skeleton=doc.skeleton, res=None,
+                              # the binding too, so the soles are held on the skin; a
+                              # re-bind replaces it (never edits it), so this is a snapshot
                               target=SimpleNamespace(skeleton=doc.skeleton,
-                                                     clips=dict(doc.clips)),
+                                                     clips=dict(doc.clips),
+                                                     binding=doc.rig.binding),
                               base=_clip_name(path, name, len(names) > 1))
         self._close_dialog()
         self.ctx = ctx
