@@ -262,6 +262,20 @@ def test_interior_faces_and_nested_shell_rig(human):
     assert _cd_to_truth(rig, human.skeleton, list(human.skeleton.names[1:])) < 2.0
 
 
+# ------------------------------------------------------------------ one part through itself
+def test_self_intersecting_mesh_goes_through_the_proxy(human):
+    """One closed part, no holes, no non-manifold edge: the left arm pushed down into the
+    chest. Ray parity counts the chest where the arm runs through it as outside."""
+    v = human.vertices.copy()
+    v[v[:, 0] > 0.3] -= (0.45, 0.15, 0.0)
+    chest = np.array([[0.05, 1.28, -0.01]])
+    assert distance_field(v, human.faces)(chest)[0] < 0
+    c = check_mesh(v, human.faces, "bent.obj")
+    assert not c.holes and c.nonmanifold == 0 and len(c.part_shares) == 1
+    assert c.proxy is not None and c.proxy_reason.startswith("self-intersecting: ")
+    assert distance_field(*c.embedding_mesh())(chest)[0] > 0
+
+
 # ---------------------------------------------------------------------------- refusals
 def test_flat_sheet_and_point_cloud_are_refused(tmp_path):
     g = np.linspace(0.0, 1.0, 11)

@@ -11,10 +11,13 @@ is (the fast path, unchanged for closed meshes) when:
   past such holes);
 - no edge is shared by more than two triangles (interior faces break ray parity);
 - one part holds the body: parts under :data:`SMALL_PART` (1%) of the area (eyes, teeth,
-  buttons) ride along outside the embedding (they get skin weights like the rest).
+  buttons) ride along outside the embedding (they get skin weights like the rest);
+- a surface without holes does not run through itself: along grid lines, at most
+  :data:`MAX_TWICE` (0.5%) of its inside is enclosed twice (the winding number, for a
+  consistently facing surface; parity calls such places outside).
 
-Any other mesh (open, non-manifold, several parts that may overlap or nest, interior faces,
-triangle soup) is embedded in a watertight proxy of its volume
+Any other mesh (open, non-manifold, self-intersecting, several parts that may overlap or
+nest, interior faces, triangle soup) is embedded in a watertight proxy of its volume
 (:func:`rigedit.embedding.volume.volume_proxy`), built from all its parts; the skin weights
 stay on the real mesh. ``MeshCheck.proxy_reason`` says why, and the report says so in one
 line. Refused, naming the file: no faces (a point cloud), no triangle with an area, no
@@ -36,12 +39,15 @@ from ..model import laplacian as lap
 from ..model.heat import WELD  # welded as the heat weights weld it
 
 __all__ = ["MeshCheck", "read_mesh", "check_mesh", "MAX_HOLE", "MAX_OPEN_AREA",
-           "MIN_MAIN_PART", "SMALL_PART"]
+           "MIN_MAIN_PART", "SMALL_PART", "MAX_TWICE"]
 
 MAX_HOLE = 0.10
 MAX_OPEN_AREA = 0.05
 MIN_MAIN_PART = 0.10
 SMALL_PART = 0.01
+#: A closed mesh that encloses more than this share of its inside twice (it runs through
+#: itself) goes through the proxy; a fingertip grazing a thigh does not matter.
+MAX_TWICE = 0.005
 
 
 @dataclass
@@ -266,6 +272,22 @@ def _holes(vertices, edges):
     return np.bincount(label[inv[:, 0]], weights=length, minlength=n)
 
 
+def _runs_through_itself(vertices, faces):
+    """Share of the inside that a closed, consistently facing surface encloses twice or
+    more (the winding number along grid lines): parity calls such places outside. 0.0 when
+    the facing is not consistent (the winding then says nothing)."""
+    from ..embedding.distance import line_winding
+
+    directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    if len(np.unique(directed, axis=0)) < len(directed):
+        return 0.0
+    w = line_winding(vertices, faces, axis=1)
+    if np.sum(w < 0) > np.sum(w > 0):       # facing in throughout: the same, mirrored
+        w = -w
+    inside = np.sum(w > 0)
+    return float(np.sum(w >= 2) / inside) if inside else 0.0
+
+
 def _proxy_reasons(holes, open_area, nonmanifold, edges, part_shares):
     """Why ray parity on the mesh itself cannot be trusted: one phrase per cause."""
     out = []
@@ -332,6 +354,11 @@ def check_mesh(vertices, faces, path="mesh"):
     res = MeshCheck(wv, wf, shares[label[wf[:, 0]]] >= SMALL_PART, size, holes, open_area,
                     nonmanifold, len(edges), list(shares[present][order]))
     reasons = _proxy_reasons(holes, open_area, nonmanifold, len(edges), res.part_shares)
+    if not reasons and not holes:
+        twice = _runs_through_itself(wv, wf)
+        if twice > MAX_TWICE:
+            reasons.append(f"self-intersecting: {100 * twice:.1f}% of its inside is enclosed "
+                           "twice (ray parity would call it outside)")
     if not reasons:
         return res                  # the fast path: the mesh itself is embedded
     try:
