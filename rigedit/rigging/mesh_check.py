@@ -112,7 +112,7 @@ class MeshCheck:
         if self.proxy is not None:
             p = self.proxy
             out.append(f"proxy: {self.proxy_reason}; embedded in a watertight proxy of "
-                       f"{len(p.faces) / 1000:.0f}k triangles (cells {p.h:.3g} across, "
+                       f"{len(p.faces) / 1000:.0f}k triangles (cells of {p.h:.3g}, "
                        f"{p.seconds:.1f} s)")
         return out
 
