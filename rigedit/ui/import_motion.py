@@ -19,6 +19,7 @@ from types import SimpleNamespace
 from PyQt5 import QtWidgets
 
 from ..animation.clip_names import check_clip_name
+from ..rigging.name_map import unmapped_parts
 
 __all__ = ["ImportMotion", "motion_path"]
 
@@ -156,6 +157,15 @@ class ImportMotion:
                            f"motion's unused")
             driven = set(res.mapping.values())
             rest = [n for n in ctx.skeleton.names if n not in driven]
+            # what rigedit retarget warns about: whole body parts left out (one line each)
+            doubts = [f"NOT SURE: the map leaves parts unmapped: {'; '.join(missing)}"
+                      for missing in [unmapped_parts(res.target_calibration,
+                                                     [ctx.skeleton.index[t] for t in driven])]
+                      if missing]
+            if res.facing_note:
+                doubts.append(f"NOT SURE of the facing: {res.facing_note}")
+            if doubts:
+                ctx.summary += ". " + ". ".join(doubts)
             text = (f"{ctx.path.name}, clip {ctx.clip!r} ({res.clip.duration:.2f} s): "
                     f"{ctx.summary}." + (f" Unmapped, kept at their rest pose: "
                                          f"{_names(rest)}." if rest else ""))
