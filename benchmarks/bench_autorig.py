@@ -149,7 +149,7 @@ def accuracy():
                   f"{cd_j2j(pred, truth_rig, diag):.2f}% |")
 
 
-def orientations(step):
+def orientations(step, only=None):
     """The whole pipeline (idw weights, no clips: the orientation search is what is timed)
     on each mesh turned by every ``step``-th of the 24 axis turns: the orientation
     recovered within 5 degrees, or flagged (not sure); a wrong one reported sure is a
@@ -174,6 +174,8 @@ def orientations(step):
             rig = rigedit.load_rig(path)
             meshes.append((file, rig.skin(rig.rest_pose()), rig.faces, "humanoid", [0, 1, 0],
                            [0, 0, 1]))
+    if only:
+        meshes = [m for m in meshes if only in m[0]]
     turns = TURNS[::step]
     print(f"## Orientation search: {len(turns)} of the 24 axis turns per mesh")
     print("| mesh | turns | recovered and sure | flagged (not sure) | wrong but sure | "
@@ -216,11 +218,13 @@ def main():
     p.add_argument("--accuracy", action="store_true")
     p.add_argument("--orientations", type=int, default=0, metavar="STEP",
                    help="the orientation search on every STEP-th axis turn (1: all 24)")
+    p.add_argument("--only", default=None, metavar="TEXT",
+                   help="--orientations on the meshes whose label holds TEXT only")
     args = p.parse_args()
     print(f"load average at start: {' '.join(f'{x:.1f}' for x in os.getloadavg())} "
           f"({os.cpu_count()} cores; other jobs share the machine)")
     if args.orientations:
-        orientations(args.orientations)
+        orientations(args.orientations, args.only)
     both = not (args.speed or args.accuracy or args.orientations)
     if args.speed or both:
         speed()

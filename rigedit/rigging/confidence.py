@@ -155,12 +155,17 @@ def _cell(field_, point):
     return tuple(np.clip(idx, 0, np.array(field_.inside.shape) - 1))
 
 
-def _first_kept(field_, kept, points):
-    """The first of ``points`` whose cell is kept (inside, not cut), as a cell index."""
+def _first_kept(field_, kept, points, reach=2):
+    """The kept cell (inside, not cut) nearest the first of ``points`` that has one within
+    ``reach`` cells, as a cell index (a joint at a thin limb's tip may sit just outside)."""
     for p in points:
-        c = _cell(field_, p)
-        if kept[c]:
-            return c
+        c = np.array(_cell(field_, p))
+        lo = np.maximum(c - reach, 0)
+        box = kept[tuple(slice(a, b + reach + 1) for a, b in zip(lo, c))]
+        hits = np.argwhere(box)
+        if len(hits):
+            k = np.argmin(np.linalg.norm(hits + lo - c, axis=1))
+            return tuple(hits[k] + lo)
     return None
 
 
@@ -211,7 +216,9 @@ def _limb_check(out, field_, reduced, positions, names, roles, height):
     body = labels[root_cell] if root_cell is not None else -1
     ends = {}
     for r in limbs:
-        tips = [_along(_chain_points(reduced, positions, r), f) for f in np.linspace(1, .7, 7)]
+        # the end, and back towards the cut (but not to it: before it is the body)
+        tips = [_along(_chain_points(reduced, positions, r), f)
+                for f in np.linspace(1.0, CUT_AT + 0.05, 4)]
         c = _first_kept(field_, kept, tips)
         ends[r] = labels[c] if c is not None else 0
     sizes = np.bincount(labels.ravel())
