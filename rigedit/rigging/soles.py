@@ -22,7 +22,11 @@ lifted. Where every foot on the ground must rise (or sink) the body does, by the
 them (:func:`raise_body`); the rest moves each ankle's IK goal (the foot keeps its model
 rotation, so the skin it carries moves with the ankle; where the shin carries part of it a
 measured gain per frame makes up the difference), the hips dropping where a leg cannot
-reach (:func:`rigedit.rigging.contacts.solve_legs`).
+reach (:func:`rigedit.rigging.contacts.solve_legs`). A free foot whose sole is below the
+floor because of its pitch (toes pointing through it after a push-off, a heel before a
+strike) is first turned about its ankle, the least that clears it, at most :data:`PITCH`
+degrees (:func:`pitch_feet`): the foot's direction changes, not the leg's; the ankle is
+lifted only for what is left.
 
 Pure numpy + scipy.
 """
@@ -33,14 +37,16 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.spatial.transform import Rotation
 
 from .bake import assemble
+from .calibrate import rotations_of, unit
 from .contacts import blend_frames, ramp, runs, smooth_max, solve_legs
 
 __all__ = ["Soles", "find_soles", "skin_points", "vertex_heights", "sole_heights",
            "bearing_steps", "sole_slip", "hold_offsets", "fade_runs", "source_clearance",
-           "foot_legs", "standing", "raise_body", "hold_soles", "sole_measures",
-           "DOMINANT", "TOLERANCE", "STANDING", "PATCH"]
+           "foot_legs", "standing", "raise_body", "pitch_feet", "hold_soles",
+           "sole_measures", "DOMINANT", "TOLERANCE", "STANDING", "PATCH", "PITCH"]
 
 #: A vertex belongs to a foot when at least this much of its weight is on the foot's joints.
 DOMINANT = 0.5
@@ -58,6 +64,13 @@ CHUNK = 512
 #: The patch a foot stands on: its vertices within this share of the foot's size of its
 #: lowest (4 mm on a 27 cm foot).
 PATCH = 0.015
+#: The most a foot is pitched about its ankle (degrees, toes up or heel up) to take a sole
+#: out of the floor before the ankle is lifted (which bends the leg): a swing foot whose
+#: toes point through the floor turns them up instead.
+PITCH = 45.0
+#: Pitch angles tried per side (the least that suffices is taken).
+PITCH_STEPS = 12
+
 
 
 @dataclass
@@ -429,6 +442,96 @@ def raise_body(weights, change, blend):
     return np.convolve(np.pad(need, blend, mode="edge"), kernel, mode="valid")
 
 
+def _turned(sk, mats, joints, turn):
+    """``mats`` (F, J, 4, 4) with the foot ``joints`` (the ankle first) turned by ``turn``
+    (F, 3, 3) about the ankle."""
+    out = mats.copy()
+    ankle = mats[:, joints[0], :3, 3]
+    for j in joints:
+        out[:, j, :3, :3] = turn @ mats[:, j, :3, :3]
+        out[:, j, :3, 3] = ankle + np.einsum("fab,fb->fa", turn, mats[:, j, :3, 3] - ankle)
+    return out
+
+
+def _foot_low(soles, skeleton, mats, i):
+    """(F,) model y of foot ``i``'s lowest skinned point in the poses ``mats``."""
+    a, b = soles.offsets[i], soles.offsets[i + 1]
+    pal = _palette(soles, skeleton, mats)[:, :, 1, :].reshape(len(mats), -1)
+    return (soles.lifted[a:b] @ pal.T).min(axis=0)
+
+
+def pitch_feet(soles, sk, tgt, rot, mats, need, freedom, blend, tol):
+    """Turn each foot about its ankle (toes up or heel up, at most :data:`PITCH` degrees)
+    where its sole must rise: a foot pitched through the floor comes out by turning, not
+    by lifting the ankle, which would bend the leg away from the source's directions.
+
+    In each frame the least pitch that takes the sole up by ``need`` is taken (the one that
+    lifts it most where none suffices; none where no pitch lifts it), scaled by
+    ``freedom`` and spread over a third of ``blend`` frames either way
+    (:func:`rigedit.rigging.contacts.smooth_max` on the toes-up and heels-up parts), so
+    the foot does not snap (a wider spread turns frames that need no turn, and a heel then
+    goes down); the legs' IK takes what is left.
+
+    Parameters
+    ----------
+    soles : Soles
+    sk : Skeleton
+    tgt : Calibration or LegCalibration
+    rot : (F, J, 3, 3) float64
+        Model rotations (changed in place for the feet's joints).
+    mats : (F, J, 4, 4) float64
+        ``rot`` assembled.
+    need : (F, n_feet) float64
+        How far each foot's lowest point must rise (model units; 0 where it need not).
+    freedom : (F, n_feet) float64
+        0..1, how much of the pitch a foot may take (0 where it stands: turning there
+        would slide the patch it stands on).
+    blend : int
+    tol : float
+        Needs below this are none.
+
+    Returns
+    -------
+    pitched : bool
+        Whether any foot turned (then ``rot`` has changed and ``mats`` is stale).
+    """
+    pitched = False
+    grid = np.radians(np.linspace(-PITCH, PITCH, 2 * PITCH_STEPS + 1))
+    grid = grid[np.argsort(np.abs(grid), kind="stable")]        # the least turn first
+    # about the body's left axis, as the knee bends (measured: Bandai's walk onto CesiumMan,
+    # legs 4.1 degrees off the source's; 6.5 about an axis square to where each foot points)
+    lateral = unit(rot[:, tgt.hips] @ (rotations_of(tgt.mats)[tgt.hips].T @ tgt.left))
+    for i, joints in enumerate(soles.joints):
+        fr = np.flatnonzero((need[:, i] > tol) & (freedom[:, i] > 0))
+        if len(fr) == 0:
+            continue
+        m = mats[fr]
+        axis = lateral[fr]
+        base = _foot_low(soles, sk, m, i)
+        rise = np.stack([_foot_low(soles, sk, _turned(sk, m, joints, Rotation.from_rotvec(
+            axis * g).as_matrix()), i) - base for g in grid], axis=1)  # (len(fr), K)
+        enough = rise >= need[fr, i, None] - tol
+        best = np.where(enough.any(axis=1), np.argmax(enough, axis=1), np.argmax(rise, axis=1))
+        angle = np.zeros(len(rot))
+        angle[fr] = np.where(rise[np.arange(len(fr)), best] > tol, grid[best], 0.0) \
+            * freedom[fr, i]
+        if not angle.any():
+            continue
+        # each side spread on its own: a toes-up swing and a heel-up one do not cancel
+        up, down = np.maximum(angle, 0.0), np.maximum(-angle, 0.0)
+        angle = (smooth_max(up, max(1, blend // 3)) if up.any() else up) \
+            - (smooth_max(down, max(1, blend // 3)) if down.any() else down)
+        angle *= freedom[:, i]                  # still 0 where the foot stands
+        turn_at = np.flatnonzero(np.abs(angle) > 1e-9)
+        if len(turn_at) == 0:
+            continue
+        turn = Rotation.from_rotvec(lateral[turn_at] * angle[turn_at, None]).as_matrix()
+        for j in joints:
+            rot[turn_at, j] = turn @ rot[turn_at, j]
+        pitched = True
+    return pitched
+
+
 def _move_feet(sk, tgt, rot, hips_pos, mats, legs, move, blend, mapped):
     """Each leg's ankle moved by ``move`` (F, n_feet, 3) by two-bone IK (the hips dropping
     where a leg cannot reach); returns ``rot``, ``hips_pos``, ``mats``."""
@@ -500,11 +603,21 @@ def hold_soles(rig, tgt, rot, hips_pos, mats, contact, clearance, times, mapped,
         y = vertex_heights(soles, sk, mats)
         low = sole_heights(soles, sk, mats, y) - soles.floor
     # standing, the sole goes onto the floor, the change faded out before and after as the
-    # joints' pins are; elsewhere a sole below the floor is lifted (the lift spread over the
-    # fade's width so a swing does not kink)
+    # joints' pins are; elsewhere a sole below the floor is turned out of it, then lifted
     onto = _onto_floor(low, held, blend)
+    # a sole through the floor where the foot is free: pitch the foot first (toes or heel
+    # up), the ankle's lift below only takes what is left, and the legs keep their bend
+    need = np.where(held, 0.0, np.maximum(0.0, -(low + onto)))
+    if need.max() > tol and pitch_feet(soles, sk, tgt, rot, mats, need, ~held, blend, tol):
+        mats = assemble(sk, rot, tgt.hips, hips_pos)
+        y = vertex_heights(soles, sk, mats)
+        low = sole_heights(soles, sk, mats, y) - soles.floor
+        onto = _onto_floor(low, held, blend)
+    # what the pitch leaves is lifted, spread over a third of the fade's width (a wider
+    # spread bends the leg through the whole swing for a few frames' need)
     lift = np.where(held, 0.0, np.maximum(0.0, -(low + onto)))
-    lift = np.stack([smooth_max(c, blend) if c.any() else c for c in lift.T], axis=1)
+    lift = np.stack([smooth_max(c, max(1, blend // 3)) if c.any() else c for c in lift.T],
+                    axis=1)
     goal = low + onto + np.where(held, 0.0, lift)
     # the skin does not slide while it stands (the joints' pins hold the ankle and toe, but
     # a foot turning about its ankle still slides its sole)
