@@ -61,12 +61,14 @@ def box_feet_rig(skeleton, boxes, name="boxes"):
                name=name)
 
 
-def deep_heels(humanoid):
+def deep_heels(humanoid, toes=None):
     """The bundled humanoid's skeleton with box feet reaching 10 cm behind the ankle and down
     to the floor (9 cm below the ankle joint), and box toes reaching 6 cm past the toe
     tail: a heel strike with the ankle at its rest height puts the heel's corner about 2 cm
     below the floor, which the joints' clean-up (ankle, toe and toe tail above their rest
-    heights) does not see."""
+    heights) does not see. ``toes``: the toes reach that far past the toe joint instead
+    (a long shoe: 0.25 puts a swing foot's toes through the floor after the push-off, as
+    CesiumMan's go)."""
     sk = humanoid.skeleton
     p = sk.bind_matrices[:, :3, 3]
     boxes = {}
@@ -74,7 +76,8 @@ def deep_heels(humanoid):
         ankle, toe = p[sk.index[f"{side}Foot"]], p[sk.index[f"{side}ToeBase"]]
         x = ankle[0]
         boxes[f"{side}Foot"] = ([x - 0.045, 0.0, ankle[2] - 0.10], [x + 0.045, ankle[1], toe[2]])
-        boxes[f"{side}ToeBase"] = ([x - 0.045, 0.0, toe[2]], [x + 0.045, 0.045, 0.26])
+        tip = 0.26 if toes is None else toe[2] + toes
+        boxes[f"{side}ToeBase"] = ([x - 0.045, 0.0, toe[2]], [x + 0.045, 0.045, tip])
     return box_feet_rig(sk, boxes, "deep heels")
 
 
@@ -240,21 +243,6 @@ def test_a_target_without_a_binding_keeps_the_joints(humanoid):
     np.testing.assert_array_equal(res.mats, joints.mats)
 
 
-def long_toes(humanoid):
-    """:func:`deep_heels`' feet with toes reaching 25 cm past the toe joint (a long shoe): a swing
-    foot whose toes point down after the push-off puts them through the floor, as
-    CesiumMan's do."""
-    sk = humanoid.skeleton
-    p = sk.bind_matrices[:, :3, 3]
-    boxes = {}
-    for side in ("Left", "Right"):
-        ankle, toe = p[sk.index[f"{side}Foot"]], p[sk.index[f"{side}ToeBase"]]
-        x = ankle[0]
-        boxes[f"{side}Foot"] = ([x - 0.045, 0.0, ankle[2] - 0.10], [x + 0.045, ankle[1], toe[2]])
-        boxes[f"{side}ToeBase"] = ([x - 0.045, 0.0, toe[2]], [x + 0.045, 0.045, toe[2] + 0.25])
-    return box_feet_rig(sk, boxes, "long toes")
-
-
 def test_pitched_soles_turn_the_foot_not_the_leg(humanoid):
     """Long toes through the floor in the swing: the foot turns about its ankle
     (:func:`rigedit.rigging.soles.pitch_feet`) and the legs keep nearer the source's
@@ -263,7 +251,7 @@ def test_pitched_soles_turn_the_foot_not_the_leg(humanoid):
     without the sole step.)"""
     from rigedit.rigging.measure import direction_errors
     src = rigedit.load_rig(BANDAI_WALK)
-    target = long_toes(humanoid)
+    target = deep_heels(humanoid, toes=0.25)
     with mock.patch("rigedit.rigging.soles.PITCH", 0.0):
         lifted = retarget_result(src, "take", target)
     turned = retarget_result(src, "take", target)
