@@ -248,8 +248,16 @@ def read_mesh(path, with_surface=False):
     if len(faces) == 0:
         raise RigFileError(path, "expected a surface mesh (triangles or polygons), got no "
                                  "faces: a point cloud has no inside to place a skeleton in")
-    out = np.asarray(vertices, dtype=np.float64), np.asarray(faces, dtype=np.int64)
-    return (*out, surface) if with_surface else out
+    vertices, faces = np.asarray(vertices, dtype=np.float64), np.asarray(faces, dtype=np.int64)
+    if surface is None:
+        # drop points no triangle uses (a glTF's meshes may carry some), as load_mesh does:
+        # a rig folder saved from this mesh is read back without them, and its weights.npz
+        # must then still fit (RobotExpressive has 4: its folder did not load)
+        used = np.zeros(len(vertices), dtype=bool)
+        used[faces.ravel()] = True
+        if not used.all():
+            vertices, faces = vertices[used], (np.cumsum(used) - 1)[faces]
+    return (vertices, faces, surface) if with_surface else (vertices, faces)
 
 
 def _edges(faces):
