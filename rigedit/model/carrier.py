@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .skeleton import subtree_of
+
 __all__ = ["carrier_joints", "carrier_note", "figure_root", "FLOOR", "CLIMB", "MARGIN",
            "MAX_CHAIN"]
 
@@ -47,15 +49,6 @@ def _children(parents):
         if p >= 0:
             kids[p].append(j)
     return kids
-
-
-def _subtree(kids, j):
-    out, stack = [], [j]
-    while stack:
-        k = stack.pop()
-        out.append(k)
-        stack.extend(kids[k])
-    return out
 
 
 def _carries(points, c, child, figure, up):
@@ -108,7 +101,7 @@ def carrier_joints(parents, points, up=(0.0, 1.0, 0.0)):
             if len(kids[c]) != 1:
                 break
             child = kids[c][0]
-            figure = _subtree(kids, child)
+            figure = subtree_of(parents, child)
             if not any(len(kids[k]) >= 2 for k in figure) or \
                     np.mean(_carries(points, c, child, figure, up)) < 0.5:
                 break

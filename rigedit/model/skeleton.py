@@ -7,7 +7,7 @@ import numpy as np
 
 from .transforms import compose_trs, normalize_quats
 
-__all__ = ["Skeleton", "topological_order"]
+__all__ = ["Skeleton", "topological_order", "subtree_of"]
 
 
 def topological_order(names, parent_names):
@@ -174,12 +174,7 @@ class Skeleton:
 
     def subtree(self, j):
         """Indices of joint ``j`` and all its descendants, in stored order."""
-        inside = np.zeros(len(self.names), dtype=bool)
-        inside[j] = True
-        for k in range(j + 1, len(self.names)):
-            if self.parents[k] >= 0 and inside[self.parents[k]]:
-                inside[k] = True
-        return np.flatnonzero(inside)
+        return subtree_of(self.parents, j)
 
     def bones(self):
         """Bone segments as (parent, child) joint index pairs, (B, 2) int."""
@@ -257,3 +252,25 @@ class Skeleton:
         for n in names:
             mask[self.joint_index(n)] = True
         return mask
+
+
+def subtree_of(parents, j):
+    """Indices of joint ``j`` and all its descendants, in stored order.
+
+    Parameters
+    ----------
+    parents : (J,) int
+        Parent before child (``parents[k] < k``; a root's parent is -1), as a
+        :class:`Skeleton` stores them and BVH and glTF readers produce them.
+    j : int
+
+    Returns
+    -------
+    (N,) int64
+    """
+    inside = np.zeros(len(parents), dtype=bool)
+    inside[j] = True
+    for k in range(j + 1, len(parents)):
+        if parents[k] >= 0 and inside[parents[k]]:
+            inside[k] = True
+    return np.flatnonzero(inside)
