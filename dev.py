@@ -89,7 +89,7 @@ def ensure_venv(extra):
     if subprocess.run([str(PY), "-m", "pip", "install", "-q", "-e", ".[fast]"],
                       cwd=ROOT).returncode != 0:
         say("scikit-sparse did not install: heat weights use SciPy's SuperLU (slower)")
-    subprocess.run([str(PY), "-c", "from rigedit.model import visibility as v; v.warm()"],
+    subprocess.run([str(PY), "-c", "from rigedit.binding import visibility as v; v.warm()"],
                    cwd=ROOT)
     stamp.touch()
 

@@ -45,7 +45,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 import rigedit  # noqa: E402
 from rigedit.embedding import cd_j2j  # noqa: E402
-from rigedit.rigging.mesh_check import read_mesh  # noqa: E402
+from rigedit.rigging.autorig.mesh_check import read_mesh  # noqa: E402
 # the artists' joints that the humanoid template's joints map onto (the embedding tests')
 from test_embedding import DATA, KHRONOS  # noqa: E402
 from test_autorig_orient import TURNS  # noqa: E402  (the 24 axis turns)
@@ -154,7 +154,7 @@ def orientations(step, only=None):
     on each mesh turned by every ``step``-th of the 24 axis turns: the orientation
     recovered within 5 degrees, or flagged (not sure); a wrong one reported sure is a
     failure."""
-    from rigedit.rigging.mesh_check import read_mesh as read
+    from rigedit.rigging.autorig.mesh_check import read_mesh as read
 
     meshes = []
     for name, template, up, fwd in (("humanoid", "humanoid", [0, 1, 0], [0, 0, 1]),

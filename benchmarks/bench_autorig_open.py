@@ -37,7 +37,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import rigedit  # noqa: E402
-import rigedit.rigging.mesh_check as mesh_check  # noqa: E402
+import rigedit.rigging.autorig.mesh_check as mesh_check  # noqa: E402
 from rigedit.embedding import cd_j2j  # noqa: E402
 from test_autorig_open_meshes import _cd_to_truth, _seam, _soup, open_humanoid  # noqa: E402
 from test_embedding_stretch import SHARED, shared_case  # noqa: E402

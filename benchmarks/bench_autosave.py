@@ -5,9 +5,9 @@ Prints the median and worst of N runs of:
 - the UI thread's part of a timer autosave (``rigedit.ui.autosave.Autosave.save`` with
   ``background=True``): a shallow copy of the rig with copies of its clips, and the pose
   snapshot;
-- the writer thread's part: :func:`rigedit.recovery.write_entry` (a rig folder through
+- the writer thread's part: :func:`rigedit.editor.recovery.write_entry` (a rig folder through
   ``save_rig_folder`` plus ``recovery.json``), what a crash or signal save costs in full;
-- reading the entry back (:func:`rigedit.recovery.read_entry`), what Recover costs.
+- reading the entry back (:func:`rigedit.editor.recovery.read_entry`), what Recover costs.
 
 Run: ``.venv/bin/python benchmarks/bench_autosave.py [--runs N]``. The cache folder is a
 temporary one.
@@ -41,7 +41,7 @@ def main():
     args = parser.parse_args()
     os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp(prefix="bench-autosave-")
     import rigedit
-    from rigedit import recovery
+    from rigedit.editor import recovery
 
     print(f"{'rig':<10} {'vertices':>8} {'UI thread ms':>14} {'write ms':>14} {'read ms':>14}"
           "   (median / worst)")

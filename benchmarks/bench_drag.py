@@ -10,7 +10,7 @@
 
 3. ``--big``: the same window drag on a big character, the quadruped with each triangle
    split at its centroid twice (540,000 triangles, 270,002 vertices, weights interpolated;
-   ``rigedit.model.subdivide``), twice in turn: as the editor draws it (its decimated proxy
+   ``rigedit.binding.subdivide``), twice in turn: as the editor draws it (its decimated proxy
    while the joint moves, the full mesh on release) and with the proxy turned off (the full
    mesh every frame); frames/s of each and what the status bar said.
 
@@ -133,7 +133,7 @@ def big_rig(rig, levels=2):
     """``rig`` with every triangle split at its centroid ``levels`` times (3**levels times
     the triangles), weights interpolated, same skeleton and clips."""
     from rigedit import Rig
-    from rigedit.model.subdivide import subdivide_centroid
+    from rigedit.binding.subdivide import subdivide_centroid
 
     b = rig.binding
     v, f, idx, w = subdivide_centroid(rig.vertices, rig.faces, b.indices, b.weights,

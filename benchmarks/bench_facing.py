@@ -7,11 +7,11 @@ For each clip and target (:func:`rigedit.rigging.retarget_result`, the automatic
 
 - ``turn°``: the facing turn applied to the source (a multiple of 90);
 - ``source°``: the median over the travelling frames of the source hips' heading relative
-  to their path (:func:`rigedit.rigging.facing.relative_heading`: the pelvis' forward
+  to their path (:func:`rigedit.rigging.retarget.facing.relative_heading`: the pelvis' forward
   against the direction the hips travel over 0.5 s; frames slower than 0.3 leg lengths a
   second have no path, and a clip with none shows ``-``);
 - ``offset° mean / max``: the target's relative heading minus the source's
-  (:func:`rigedit.rigging.facing.heading_offsets`), mean and largest absolute value over the
+  (:func:`rigedit.rigging.retarget.facing.heading_offsets`), mean and largest absolute value over the
   travelling frames: the issue's target is within 10 degrees.
 
 ``--frame0`` judges the facing as before this work, for comparison: the source's forward
@@ -32,12 +32,12 @@ from bench_retarget import _table  # noqa: E402  (the benchmarks folder is on sy
 from bench_retarget_library import TARGETS, sources
 
 # the module, not the function rigedit.rigging exports under the same name
-retarget_module = importlib.import_module("rigedit.rigging.retarget")
-from rigedit.rigging.facing import heading_degrees, heading_offsets, relative_heading
+retarget_module = importlib.import_module("rigedit.rigging.retarget.pipeline")
+from rigedit.rigging.retarget.facing import heading_degrees, heading_offsets, relative_heading
 
 
 def _frame0_rule():
-    """Make :mod:`rigedit.rigging.retarget` judge facing on the calibration pose's feet."""
+    """Make :mod:`rigedit.rigging.retarget.pipeline` judge facing on the calibration pose's feet."""
     def facing(src, tgt, smats):
         a = heading_degrees(tgt.forward) - heading_degrees(src.forward)
         deg = float(np.round(a / 90.0) * 90.0) % 360.0

@@ -23,7 +23,7 @@ from threadpoolctl import threadpool_limits
 from rigedit.model import (Pose, Skeleton, SkinBinding, local_to_model, skinning_kernels,
                            skinning_matrices)
 from rigedit.model.skinning import top_k_influences
-from rigedit.model.weights import compute_weights
+from rigedit.binding.weights import compute_weights
 
 J, K = 40, 4
 

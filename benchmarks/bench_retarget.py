@@ -15,7 +15,7 @@ the same measures per chain group (legs: every bone from the shoulder blade or h
 the hoof; spine: pelvis to the fore legs' branch; head: neck, head, jaw, ears, antlers; tail),
 the slip of each hoof joint during its contacts, and the time of each clip and of all four.
 A target with other joint names is retargeted with a JSON-style map and with the map found
-from the trees' shape (:mod:`rigedit.rigging.tree_map`).
+from the trees' shape (:mod:`rigedit.rigging.retarget.tree_map`).
 
 ``--autorig``: also each template's clips onto characters auto-rigged from it
 (``rigedit.autorig(mesh, template, clips=False)``, then :func:`retarget_result` per clip, as
@@ -30,7 +30,7 @@ from pathlib import Path
 
 import rigedit
 from rigedit.rigging import retarget_result
-from rigedit.rigging.measure import (direction_errors, foot_slip, lowest_foot,
+from rigedit.rigging.retarget.measure import (direction_errors, foot_slip, lowest_foot,
                                      source_foot_points, target_foot_points)
 
 REPO = Path(__file__).resolve().parents[1]

@@ -13,7 +13,7 @@ RiggedFigure's. For each clip and target (default settings of
   after the facing turn, over all frames, averaged over the bones (every measured bone:
   arms, legs, spine, head, fingers and feet), before and after the foot clean-up;
 - ``no feet°``: the same without the foot and toe bones, whose pitch is transferred
-  relative to each figure's flat foot by design (:mod:`rigedit.rigging.transfer`);
+  relative to each figure's flat foot by design (:mod:`rigedit.rigging.retarget.transfer`);
 - ``flat feet°``: every bone again, the feet measured as designed: each foot or toe bone
   against its source bone pitched by the bone's constant offset (the median over the
   frames), i.e. whether the foot moves as its source moves from its flat foot;
@@ -34,9 +34,9 @@ import numpy as np
 import rigedit
 from bench_retarget import _table  # noqa: E402  (the benchmarks folder is on sys.path)
 from rigedit.rigging import retarget_result
-from rigedit.rigging.calibrate import unit
-from rigedit.rigging.measure import direction_errors
-from rigedit.rigging.transfer import end_points, pitch_of, pitched
+from rigedit.model.transforms import unit
+from rigedit.rigging.retarget.measure import direction_errors
+from rigedit.rigging.retarget.transfer import end_points, pitch_of, pitched
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"

@@ -3,9 +3,9 @@
     .venv/bin/python benchmarks/bench_soles.py [--markdown] [--no-autorig] [--library]
 
 For each case the clip is retargeted with :func:`rigedit.rigging.retarget_result` twice:
-"before" with the skin step (:func:`rigedit.rigging.soles.hold_soles`) replaced by a
+"before" with the skin step (:func:`rigedit.rigging.retarget.soles.hold_soles`) replaced by a
 no-op (the joint clean-up alone, as rigedit did before it), "after" as it is. Measured on the
-skinned feet (each foot's vertices, :func:`rigedit.rigging.soles.find_soles`: at least half
+skinned feet (each foot's vertices, :func:`rigedit.rigging.retarget.soles.find_soles`: at least half
 their weight on the ankle and the joints below it), relative to the floor (the lowest sole
 point in the target's calibration pose, its rest):
 
@@ -39,7 +39,7 @@ import numpy as np
 
 import rigedit
 from rigedit.rigging import retarget_result
-from rigedit.rigging.soles import sole_measures
+from rigedit.rigging.retarget.soles import sole_measures
 
 from bench_retarget import _table
 
@@ -69,7 +69,7 @@ def measure(res, rig, source):
 
 def run(source, clip, target):
     """``(before, after, seconds)`` measures of one case."""
-    with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
+    with mock.patch("rigedit.rigging.retarget.pipeline.hold_soles", _passthrough):
         before = measure(retarget_result(source, clip, target), target, source)
     t0, c0 = time.perf_counter(), time.process_time()
     res = retarget_result(source, clip, target)

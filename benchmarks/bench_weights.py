@@ -85,7 +85,7 @@ def case(name):
 
 def child(name, method, repeat, solver):
     """Run one case in this process; print one JSON line."""
-    from rigedit.model.weights import compute_weights
+    from rigedit.binding.weights import compute_weights
     sk, verts, faces = case(name)
     base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     options = {"solver": solver} if method == "heat" else {}

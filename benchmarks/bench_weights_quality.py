@@ -38,7 +38,7 @@ from scipy.spatial import cKDTree
 from rigedit.io import gltf_read
 from rigedit.io.load import load_rig
 from rigedit.model.skinning import dense_weights, top_k_influences
-from rigedit.model.weights import compute_weights
+from rigedit.binding.weights import compute_weights
 
 DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
 # (label, file under DATA or a bundled name, skin index)

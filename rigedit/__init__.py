@@ -69,8 +69,8 @@ def load_rig(rig=None, weights_method=None, scale=None):
 
 def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_feet=True):
     """Retarget a clip onto another character: two humanoids, or any two skeletons with legs
-    whose joints share names or are mapped (see :func:`rigedit.rigging.retarget`)."""
-    from .rigging.retarget import retarget as _retarget
+    whose joints share names or are mapped (see :func:`rigedit.rigging.retarget.pipeline`)."""
+    from .rigging.retarget.pipeline import retarget as _retarget
 
     return _retarget(source_rig, source_clip, target_rig, map=map, name=name,
                      clean_feet=clean_feet)
@@ -79,10 +79,10 @@ def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_fee
 def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", clips=True,
             progress=None, hints=None):
     """Rig a static mesh: embed a template skeleton, bind it, give it the template's clips
-    (see :func:`rigedit.rigging.autorig.autorig`; ``hints`` pins joints, {name: (x, y, z)}
+    (see :func:`rigedit.rigging.autorig.pipeline.autorig`; ``hints`` pins joints, {name: (x, y, z)}
     in the mesh's coordinates); ``rig.autorig_report`` says what was decided (orientation,
     checks, stage times)."""
-    from .rigging.autorig import autorig as _autorig
+    from .rigging.autorig.pipeline import autorig as _autorig
 
     return _autorig(mesh, template=template, up=up, forward=forward, weights=weights,
                     clips=clips, progress=progress, hints=hints)

@@ -6,7 +6,7 @@ import numpy as np
 from .model.kinematics import local_to_model, skinning_matrices
 from .model.pose import Pose
 from .model.skinning import SkinBinding
-from .model.weights import compute_weights, default_method
+from .binding.weights import compute_weights, default_method
 
 __all__ = ["Rig"]
 

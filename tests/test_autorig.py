@@ -13,11 +13,11 @@ from scipy.spatial import ConvexHull
 from scipy.spatial.transform import Rotation
 
 import rigedit
-from rigedit.cli import main
+from rigedit.cli.main import main
 from rigedit.errors import RigFileError
 from rigedit.io.mesh import save_obj
 from rigedit.model.skeleton import Skeleton
-from rigedit.rigging.autorig import build_skeleton, load_template
+from rigedit.rigging.autorig.pipeline import build_skeleton, load_template
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 HOMER = DATA / "common-3d-test-models" / "homer.obj"
@@ -316,7 +316,7 @@ def test_bvh_template_lying_at_rest_is_stood_up_from_its_first_frame():
         pytest.skip(f"{bvh} is absent (shared test data)")
     import warnings
 
-    from rigedit.rigging.autorig import template_poses
+    from rigedit.rigging.autorig.pipeline import template_poses
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # the BVH's guessed units

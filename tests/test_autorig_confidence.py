@@ -16,9 +16,9 @@ import pytest
 import rigedit
 from rigedit.embedding.distance import distance_field
 from rigedit.embedding.template import reduce_template
-from rigedit.rigging.confidence import check_embedding, fit_score, limb_roles
-from rigedit.rigging.orient import hypotheses
-from rigedit.rigging.orient_search import MARGIN, search
+from rigedit.rigging.autorig.confidence import check_embedding, fit_score, limb_roles
+from rigedit.rigging.autorig.orient import hypotheses
+from rigedit.rigging.autorig.orient_search import MARGIN, search
 
 from test_autorig_orient import TURNS   # the 24 axis-aligned turns
 
@@ -175,8 +175,8 @@ def test_broken_mirror_and_bone_outside_and_stretch(own_rig):
 
 # ------------------------------------------------------------------- the orientation search
 def test_search_picks_the_lowest_score_and_skips_failures():
-    from rigedit.rigging.confidence import Confidence
-    from rigedit.rigging.orient import Orientation
+    from rigedit.rigging.autorig.confidence import Confidence
+    from rigedit.rigging.autorig.orient import Orientation
 
     frames = [Orientation(np.array([0.0, 1, 0]), np.array([0.0, 0, 1]), guessed=True),
               Orientation(np.array([0.0, -1, 0]), np.array([0.0, 0, -1]), guessed=True),
@@ -276,7 +276,7 @@ COW_TURNS = {   # input axis for rigedit's (+X left, +Y up, +Z forward) -> turn 
 
 @pytest.mark.parametrize("turn", list(COW_TURNS))
 def test_cow_turned_rigs_as_a_cow_or_says_not_sure(turn):
-    from rigedit.rigging.mesh_check import read_mesh
+    from rigedit.rigging.autorig.mesh_check import read_mesh
 
     v, f = read_mesh(DATA / "common-3d-test-models" / "cow.obj")   # Y up, facing +X
     up, fwd = (np.asarray(a, float) for a in COW_TURNS[turn])
@@ -305,7 +305,7 @@ def test_shared_meshes_stay_sure_and_right(name, template):
 
 
 def test_cli_strict_refuses_a_not_sure_rig_and_warns_without(tmp_path, capsys, cartoon_mesh):
-    from rigedit.cli import main
+    from rigedit.cli.main import main
     from rigedit.io.mesh import save_obj
 
     path = tmp_path / "big_ears.obj"

@@ -10,7 +10,7 @@ from scipy.spatial import ConvexHull
 import rigedit
 from rigedit.errors import RigFileError
 from rigedit.io.mesh import save_obj
-from rigedit.rigging.mesh_check import MAX_HOLE, check_mesh, read_mesh
+from rigedit.rigging.autorig.mesh_check import MAX_HOLE, check_mesh, read_mesh
 
 CESIUM = Path(__file__).resolve().parents[2] / "shared" / "data" / "khronos-gltf" / \
     "CesiumMan.glb"

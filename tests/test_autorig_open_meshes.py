@@ -18,7 +18,7 @@ from rigedit.embedding import cd_j2j
 from rigedit.embedding.distance import distance_field
 from rigedit.errors import RigFileError
 from rigedit.io.mesh import save_obj
-from rigedit.rigging.mesh_check import MAX_HOLE, MAX_OPEN_AREA, check_mesh
+from rigedit.rigging.autorig.mesh_check import MAX_HOLE, MAX_OPEN_AREA, check_mesh
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 
@@ -328,7 +328,7 @@ def test_shared_characters_rig_with_their_skeleton_ignored(path, template, limit
 def test_robot_of_node_parts_is_read_whole():
     """RobotExpressive's body parts hang from its bones (only its hands are skinned): all
     of them are read where the file places them, and auto-rigged through the proxy."""
-    from rigedit.rigging.mesh_check import read_mesh
+    from rigedit.rigging.autorig.mesh_check import read_mesh
 
     path = DATA / "threejs-characters" / "RobotExpressive.glb"
     with warnings.catch_warnings():
@@ -375,7 +375,7 @@ def _static_gltf(path, parts):
 
 
 def test_static_gltf_is_read_whole_where_its_nodes_place_it(tmp_path, human):
-    from rigedit.rigging.mesh_check import read_mesh
+    from rigedit.rigging.autorig.mesh_check import read_mesh
 
     v, f = human.vertices, human.faces
     box, box_f = _box_shell((-0.1, 0.0, -0.1), (0.1, 0.2, 0.1))

@@ -9,8 +9,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import rigedit
-from rigedit.rigging.mesh_check import read_mesh
-from rigedit.rigging.orient import axis_name, check_axes, orient, parse_axis
+from rigedit.rigging.autorig.mesh_check import read_mesh
+from rigedit.rigging.autorig.orient import axis_name, check_axes, orient, parse_axis
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "common-3d-test-models"
 

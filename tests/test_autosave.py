@@ -41,7 +41,7 @@ def make_editor(cache, qtbot):
 
 
 def _entries():
-    from rigedit import recovery
+    from rigedit.editor import recovery
 
     return recovery.list_entries()
 
@@ -88,7 +88,7 @@ def test_background_write_keeps_the_state_it_started_from(make_editor, qtbot, mo
     save meanwhile leaves no entry behind."""
     import threading
 
-    from rigedit import recovery
+    from rigedit.editor import recovery
 
     w = make_editor()
     auto, doc = w.autosave, w.document
@@ -195,7 +195,7 @@ def test_closing_with_unsaved_changes_asks(make_editor, monkeypatch, tmp_path):
 
 def _stale_entry(rig, pose, clip, t, original):
     """An entry as left by an editor process that no longer runs."""
-    from rigedit import recovery
+    from rigedit.editor import recovery
 
     proc = subprocess.Popen([sys.executable, "-c", "pass"])
     proc.wait()
@@ -276,7 +276,7 @@ def test_discard_and_later(make_editor):
 
 
 def test_entry_of_a_running_editor_is_not_offered(make_editor):
-    from rigedit import recovery
+    from rigedit.editor import recovery
     from rigedit.ui import autosave
     from rigedit.ui.fallback import demo_rig
 

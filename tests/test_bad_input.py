@@ -337,7 +337,7 @@ def _cli(*argv, timeout=120):
     ("--size=-5x10", None, "--size"),
 ])
 def test_render_options_are_checked(tmp_path, option, value, msg):
-    from rigedit.cli import main
+    from rigedit.cli.main import main
 
     rig_dir = tmp_path / "r"
     save_rig_folder(rig_dir, cylinder_rig())
@@ -356,7 +356,7 @@ def test_render_options_are_checked(tmp_path, option, value, msg):
 
 @pytest.mark.parametrize("k", ["0", "9", "-1", "1000000"])
 def test_max_influences_is_checked(tmp_path, k, capsys):
-    from rigedit.cli import main
+    from rigedit.cli.main import main
 
     rig_dir = tmp_path / "r"
     save_rig_folder(rig_dir, cylinder_rig())

@@ -9,7 +9,7 @@ from bvh_figures import HIPS_HEIGHT, humanoid_bvh
 from rigedit.io.bvh import load_bvh
 from rigedit.model.carrier import carrier_joints, carrier_note, figure_root
 from rigedit.rigging import retarget_result
-from rigedit.rigging.measure import direction_errors, lowest_foot
+from rigedit.rigging.retarget.measure import direction_errors, lowest_foot
 
 # a small body (metres, Y up): the hips, a left leg of three joints, a right one of two, a
 # spine and a head; CARRIED hangs it under a carrier (joint 0), hips joint 1
@@ -137,7 +137,7 @@ def test_cli_render_of_a_far_carrier_walk_frames_the_figure(tmp_path):
     the picture high, near its top)."""
     import imageio.v2 as imageio
 
-    from rigedit.cli import main
+    from rigedit.cli.main import main
 
     src = tmp_path / "far.bvh"
     src.write_text(humanoid_bvh(carrier="joint_Root", start=(0, 0, -540)))

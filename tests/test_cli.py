@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from builders import cylinder_rig
-from rigedit.cli import main
+from rigedit.cli.main import main
 from rigedit.io import save_rig_folder
 
 
@@ -190,7 +190,7 @@ def test_a_folder_that_refuses_the_temporary_file_is_reported_as_the_target(tmp_
 def test_a_swallowed_interrupt_is_raised_again_and_a_second_one_waits():
     """A VTK callback swallows the exception a signal raised inside it: the job's next
     check raises it again; a second signal does not break into the clean-up."""
-    from rigedit.cli_output import Interrupted, check_interrupted, interruptible
+    from rigedit.cli.output import Interrupted, check_interrupted, interruptible
 
     with pytest.raises(Interrupted) as info:
         with interruptible():

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from builders import chain_skeleton, cylinder_rig
-from rigedit.document import (Command, Document, UndoStack, mirror_map, mirror_name,
+from rigedit.editor.document import (Command, Document, UndoStack, mirror_map, mirror_name,
                               skeleton_with_moved_joint)
 
 
@@ -145,7 +145,7 @@ def test_rest_edit_undo_restores_skeleton_and_weights(doc):
 
 
 def test_amend_folds_a_command_into_the_last_step():
-    from rigedit.document import Command, UndoStack
+    from rigedit.editor.document import Command, UndoStack
 
     log = []
     stack = UndoStack()

@@ -108,9 +108,9 @@ def test_autorig_turns_hints_from_the_files_coordinates(humanoid):
 def test_cli_hint_options(tmp_path, capsys, humanoid):
     import json
 
-    from rigedit.cli import main
+    from rigedit.cli.main import main
     from rigedit.io.mesh import save_obj
-    from rigedit.rigging.autorig_command import read_hints
+    from rigedit.cli.autorig import read_hints
 
     mesh = tmp_path / "man.obj"
     save_obj(mesh, humanoid.vertices, humanoid.faces)

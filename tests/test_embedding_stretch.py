@@ -147,7 +147,7 @@ def shared_case(path, template):
     stand +Y up facing +Z, left at +X, rigedit's frame). The mesh is what ``rigedit.autorig``
     embeds: the body, or the watertight proxy of an open or many-part one (Xbot is open at
     the eyes, with its joints' rings as separate parts)."""
-    from rigedit.rigging.mesh_check import check_mesh
+    from rigedit.rigging.autorig.mesh_check import check_mesh
 
     rig = rigedit.load_rig(str(DATA / path))
     _, table = SHARED[path]

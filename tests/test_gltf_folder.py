@@ -59,7 +59,7 @@ def test_rig_folder_keeps_cubic_spline_tangents(tmp_path):
 def test_moving_a_joint_of_a_mesh_bound_in_its_own_frame():
     """Edit mode on CesiumMan (bound Z up, shown Y up): the joint lands where it was dragged
     in the view, every joint keeps its bind-to-rest map, so the skin at rest does not jump."""
-    from rigedit.document import skeleton_with_moved_joint
+    from rigedit.editor.document import skeleton_with_moved_joint
 
     rig = load_gltf(sample_path("CesiumMan.glb"))
     sk = rig.skeleton

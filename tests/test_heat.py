@@ -1,4 +1,4 @@
-"""Bone-heat weights: smooth, complete, robust to bad meshes (rigedit.model.heat)."""
+"""Bone-heat weights: smooth, complete, robust to bad meshes (rigedit.binding.heat)."""
 from __future__ import annotations
 
 import warnings
@@ -8,12 +8,12 @@ import pytest
 
 from builders import chain_skeleton, cylinder
 from rigedit.model import Skeleton
-from rigedit.model.heat import HeatWeightsWarning, heat_weights
-from rigedit.model.laplacian import clean_faces, cotangent_laplacian, vertex_normals, weld
+from rigedit.binding.heat import HeatWeightsWarning, heat_weights
+from rigedit.binding.laplacian import clean_faces, cotangent_laplacian, vertex_normals, weld
 from rigedit.model.skinning import dense_weights
-from rigedit.model.tails import deforming_joints
-from rigedit.model.visibility import HAVE_NUMBA, SurfaceRays
-from rigedit.model.weights import compute_weights, idw_weights
+from rigedit.binding.tails import deforming_joints
+from rigedit.binding.visibility import HAVE_NUMBA, SurfaceRays
+from rigedit.binding.weights import compute_weights, idw_weights
 
 
 def heat(v, sk, f, **kw):
@@ -81,7 +81,7 @@ def test_numpy_ray_tests_give_the_same_weights_as_the_compiled_ones():
 
 
 def test_superlu_and_cholmod_give_the_same_weights():
-    from rigedit.model import heat as heat_module
+    from rigedit.binding import heat as heat_module
     if heat_module._cholmod is None:
         pytest.skip("scikit-sparse not installed: SuperLU is the only solver")
     v, f = cylinder(height=3.0)
@@ -376,7 +376,7 @@ def test_progress_is_reported_and_a_raise_cancels():
 
 # ---------------------------------------------------------------------------- wiring
 def test_rig_defaults_to_heat_and_the_cli_prints_the_fallback_count(tmp_path, capsys):
-    from rigedit.cli import main
+    from rigedit.cli.main import main
     from rigedit.io import load_weights, save_rig_folder
     from rigedit.rig import Rig
     v, f = cylinder(height=3.0)

@@ -13,7 +13,7 @@ import numpy as np
 
 from builders import cylinder
 from rigedit.model import Skeleton
-from rigedit.model.heat import HeatWeightsWarning, heat_weights
+from rigedit.binding.heat import HeatWeightsWarning, heat_weights
 from rigedit.model.skinning import dense_weights
 
 
@@ -138,7 +138,7 @@ def test_a_separate_part_overlapping_the_body_does_not_hide_its_bones():
 
 
 def test_part_filtered_rays_agree_between_kernels():
-    from rigedit.model.visibility import HAVE_NUMBA, SurfaceRays
+    from rigedit.binding.visibility import HAVE_NUMBA, SurfaceRays
     if not HAVE_NUMBA:
         return
     ball, sf = sphere([0, 0, 0], 1.0)

@@ -228,7 +228,7 @@ def test_bad_bvh_names_file_and_line(tmp_path, change, line, problem):
 
 
 def test_cli_bad_bvh_is_one_line_exit_2(tmp_path, capsys):
-    from rigedit.cli import main
+    from rigedit.cli.main import main
 
     path = write(tmp_path, SMALL.replace("MOTION\n", ""), "bad.bvh")
     assert main(["info", str(path)]) == 2
@@ -261,7 +261,7 @@ def test_windows_line_ends_tabs_and_a_byte_order_mark(tmp_path):
     (["info", "{folder}", "--scale", "0.01"], "only with a .bvh file"),
 ])
 def test_cli_scale_errors(tmp_path, capsys, argv, problem):
-    from rigedit.cli import main
+    from rigedit.cli.main import main
 
     bvh = write(tmp_path, SMALL)
     folder = tmp_path / "folder"

@@ -7,7 +7,7 @@ import pytest
 import rigedit
 from builders import chain_skeleton
 from rigedit.animation import Clip, Track
-from rigedit.cli import main
+from rigedit.cli.main import main
 from rigedit.io.bvh import load_bvh
 from rigedit.io.bvh_write import bvh_frame_times, save_bvh
 from rigedit.model import Skeleton

@@ -9,7 +9,7 @@ import pytest
 import rigedit
 from builders import chain_skeleton, cylinder
 from rigedit.animation import Clip, Track
-from rigedit.cli import main
+from rigedit.cli.main import main
 from rigedit.io.frames import FramesWarning, Z_UP_TO_Y_UP, axis_change, change_axes
 from rigedit.model import Skeleton
 from rigedit.model.transforms import euler_to_quat

@@ -4,7 +4,7 @@ import pytest
 
 import rigedit
 from builders import cylinder_rig
-from rigedit.cli import main
+from rigedit.cli.main import main
 from rigedit.errors import RigFileError
 from rigedit.io.load import rig_kind
 

@@ -8,8 +8,8 @@ GUI = ("PyQt5", "pyvista", "pyvistaqt", "vtk", "vtkmodules", "qtpy")
 def test_pure_packages_import_no_gui_modules():
     # every module of the pure packages, not only their __init__: a GUI import hidden in a
     # submodule that the package does not import at once would slip past otherwise
-    code = ("import sys, importlib, pkgutil, rigedit, rigedit.rig, rigedit.cli, rigedit.undo, "
-            "rigedit.recovery, rigedit.document\n"
+    code = ("import sys, importlib, pkgutil, rigedit, rigedit.rig, rigedit.cli.main, rigedit.editor.undo, "
+            "rigedit.editor.recovery, rigedit.editor.document\n"
             "for pkg in ('model', 'animation', 'io', 'rigging', 'embedding'):\n"
             "    package = importlib.import_module('rigedit.' + pkg)\n"
             "    for info in pkgutil.iter_modules(package.__path__):\n"

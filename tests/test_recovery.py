@@ -1,4 +1,4 @@
-"""rigedit.recovery (pure): where recovery entries and the log go, writing and reading them,
+"""rigedit.editor.recovery (pure): where recovery entries and the log go, writing and reading them,
 which ones are stale; and the document's modified flag that decides when to write."""
 import json
 import os
@@ -8,8 +8,8 @@ import sys
 import numpy as np
 import pytest
 
-from rigedit import recovery
-from rigedit.document import Document
+from rigedit.editor import recovery
+from rigedit.editor.document import Document
 
 from cache_fixture import cache  # noqa: E402,F401 - the fixture
 

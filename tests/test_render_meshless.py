@@ -2,7 +2,7 @@
 import imageio.v2 as imageio
 import numpy as np
 
-from rigedit.cli import main
+from rigedit.cli.main import main
 from test_ui_meshless import BVH
 
 

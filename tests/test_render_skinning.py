@@ -5,7 +5,7 @@ import pyvista as pv
 import pytest
 
 from rigedit.animation import Clip, Track
-from rigedit.cli import main
+from rigedit.cli.main import main
 from rigedit.model.transforms import euler_to_quat
 from rigedit.render.recorder import record_clip
 from rigedit.render.scene import RigScene

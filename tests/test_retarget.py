@@ -16,9 +16,9 @@ from rigedit.io.frames import change_axes
 from rigedit.model import Skeleton
 from rigedit.rig import Rig
 from rigedit.rigging import auto_map, retarget_result
-from rigedit.rigging.measure import direction_errors
-from rigedit.rigging.name_map import find_slots, normalise_name
-from rigedit.rigging.soles import sole_measures
+from rigedit.rigging.retarget.measure import direction_errors
+from rigedit.rigging.retarget.name_map import find_slots, normalise_name
+from rigedit.rigging.retarget.soles import sole_measures
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"
@@ -133,7 +133,7 @@ def test_bone_directions_agree(src, tgt, results):
 
 @pytest.mark.parametrize("src,tgt", COMBOS, ids=lambda p: Path(str(p)).stem)
 def test_contacts_slip_less_and_feet_above_floor(src, tgt, results):
-    """Measured on the skin (rigedit.rigging.soles, benchmarks/bench_soles.py): the soles
+    """Measured on the skin (rigedit.rigging.retarget.soles, benchmarks/bench_soles.py): the soles
     never more than 1 mm below the floor, on it within 1 mm where the source's foot stands,
     slipping under 1 cm per contact. (The joints now follow the skin: a foot rolls and
     pivots about the patch it stands on, not its ankle, so an ankle's path during a contact

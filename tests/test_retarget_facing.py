@@ -1,4 +1,4 @@
-"""Facing judged on the whole clip (rigedit.rigging.facing): a dash that starts mid-stride,
+"""Facing judged on the whole clip (rigedit.rigging.retarget.facing): a dash that starts mid-stride,
 facing across its path, runs the way the source runs, its hips facing as the source's do
 relative to the path (the issue's target: within 10 degrees)."""
 import warnings
@@ -9,7 +9,7 @@ import pytest
 from bvh_figures import dash_twist, dash_yaw, humanoid_bvh
 from rigedit.io.bvh import load_bvh
 from rigedit.rigging import retarget_result
-from rigedit.rigging.facing import heading_offsets, relative_heading
+from rigedit.rigging.retarget.facing import heading_offsets, relative_heading
 
 SECONDS = 2.0
 

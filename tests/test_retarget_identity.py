@@ -18,8 +18,8 @@ from rigedit.animation.clip import Clip, Track
 from rigedit.model import Skeleton
 from rigedit.rig import Rig
 from rigedit.rigging import retarget_result
-from rigedit.rigging.calibrate import model_stack
-from rigedit.rigging.measure import direction_errors, lowest_foot
+from rigedit.rigging.retarget.calibrate import model_stack
+from rigedit.rigging.retarget.measure import direction_errors, lowest_foot
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"

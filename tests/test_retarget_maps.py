@@ -17,9 +17,9 @@ import rigedit
 from rigedit.model import Skeleton
 from rigedit.rig import Rig
 from rigedit.rigging import auto_map, retarget_result
-from rigedit.rigging.calibrate import calibrate
-from rigedit.rigging.measure import direction_errors
-from rigedit.rigging.name_map import find_slots, finger_pairs, unmapped_parts
+from rigedit.rigging.retarget.calibrate import calibrate
+from rigedit.rigging.retarget.measure import direction_errors
+from rigedit.rigging.retarget.name_map import find_slots, finger_pairs, unmapped_parts
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"

@@ -15,9 +15,9 @@ import rigedit
 from rigedit.io.frames import change_axes
 from rigedit.rig import Rig
 from rigedit.rigging import retarget_result
-from rigedit.rigging.calibrate import calibrate
-from rigedit.rigging.limbs import LegCalibration
-from rigedit.rigging.measure import (direction_errors, foot_slip, lowest_foot,
+from rigedit.rigging.retarget.calibrate import calibrate
+from rigedit.rigging.retarget.limbs import LegCalibration
+from rigedit.rigging.retarget.measure import (direction_errors, foot_slip, lowest_foot,
                                      source_foot_points, target_foot_points)
 
 from quadruped_variants import VARIANTS, fore_variant, renamed, variant
@@ -183,7 +183,7 @@ def test_tree_map_pairs_a_shorter_neck_and_no_antlers(quad):
     """Another build of the same animal: two neck joints instead of three, no antlers, no
     tail; the neck's ends pair, the missing joints are left out, the legs pair by side."""
     from rigedit.model import Skeleton
-    from rigedit.rigging.tree_map import tree_map
+    from rigedit.rigging.retarget.tree_map import tree_map
 
     sk = quad.skeleton
     drop = {"neck_2", "tail_1", "tail_2", "tail_3", "tail_4"} | {
@@ -372,7 +372,7 @@ def test_bird_toes_make_one_leg():
     """Three toes branching at a low foot: one leg from the thigh to the lowest toe, the
     whole foot (foot joint and toes) moving with the ankle."""
     from rigedit.model import Skeleton
-    from rigedit.rigging.limbs import find_legs
+    from rigedit.rigging.retarget.limbs import find_legs
 
     names = ["hips", "neck", "head"]
     parents = [-1, 0, 1]

@@ -410,7 +410,7 @@ def test_a_clip_deleted_before_a_crash_stays_deleted_when_the_recovery_is_saved(
     no record of them), so saving the recovered document over it deletes the deleted one."""
     import json as _json
 
-    from rigedit import recovery
+    from rigedit.editor import recovery
 
     folder = write_elk_folder(tmp_path / "elk")
     with warnings.catch_warnings():

@@ -9,7 +9,7 @@ pv = pytest.importorskip("pyvista")
 
 from rigedit import Rig  # noqa: E402
 from rigedit.model.kinematics import skinning_matrices  # noqa: E402
-from rigedit.model.subdivide import subdivide_centroid  # noqa: E402
+from rigedit.binding.subdivide import subdivide_centroid  # noqa: E402
 from rigedit.render.proxy import build_proxy, faces_to_vtk  # noqa: E402
 from rigedit.render.scene import RigScene  # noqa: E402
 from ui_window_fixture import editor_window  # noqa: E402

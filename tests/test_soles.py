@@ -1,4 +1,4 @@
-"""Feet on the floor measured on the skin (rigedit.rigging.soles): the skinned soles held on
+"""Feet on the floor measured on the skin (rigedit.rigging.retarget.soles): the skinned soles held on
 the floor during contacts, never below it, not sliding; a rig without a mesh keeps the
 joints' clean-up."""
 from __future__ import annotations
@@ -13,8 +13,8 @@ import pytest
 import rigedit
 from rigedit.rig import Rig
 from rigedit.rigging import retarget_result
-from rigedit.rigging.contacts import ramp
-from rigedit.rigging.soles import (find_soles, hold_offsets, raise_body, skin_points,
+from rigedit.rigging.retarget.contacts import ramp
+from rigedit.rigging.retarget.soles import (find_soles, hold_offsets, raise_body, skin_points,
                                    sole_measures, sole_slip, standing,
                                    vertex_heights)
 
@@ -109,7 +109,7 @@ def _skin_measures(res, rig, source=None):
 @pytest.mark.parametrize("clip", ["walk", "idle"])
 def test_deep_heels_stay_on_the_floor(humanoid, clip):
     target = deep_heels(humanoid)
-    with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
+    with mock.patch("rigedit.rigging.retarget.pipeline.hold_soles", _passthrough):
         before = _skin_measures(retarget_result(humanoid, clip, target), target, humanoid)
     after = _skin_measures(retarget_result(humanoid, clip, target), target, humanoid)
     if clip == "walk":   # the joints' clean-up alone: the heels through the floor, sliding
@@ -124,7 +124,7 @@ def test_bvh_walk_onto_box_feet(humanoid):
     Xbot's do): the sole is held where the joints' clean-up left it 1-9 cm off."""
     src = rigedit.load_rig(BANDAI_WALK)
     target = deep_heels(humanoid)
-    with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
+    with mock.patch("rigedit.rigging.retarget.pipeline.hold_soles", _passthrough):
         before = _skin_measures(retarget_result(src, "take", target), target, src)
     after = _skin_measures(retarget_result(src, "take", target), target, src)
     assert before[0] < -0.005 or before[1] > 0.005, before
@@ -138,7 +138,7 @@ def test_quadruped_hooves_on_the_floor(quadruped):
     walk every hoof's lowest skin point stays above the floor, stands on it and does not
     slide (the legs path, :class:`LegCalibration`)."""
     target = box_hooves(quadruped)
-    with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
+    with mock.patch("rigedit.rigging.retarget.pipeline.hold_soles", _passthrough):
         before = _skin_measures(retarget_result(quadruped, "walk", target), target, quadruped)
     after = _skin_measures(retarget_result(quadruped, "walk", target), target, quadruped)
     assert before[0] < -0.005 or before[1] > 0.005 or before[2] > 0.01, before
@@ -149,7 +149,7 @@ def test_rig_without_mesh_keeps_the_joints(humanoid):
     bare = Rig(humanoid.skeleton, np.zeros((0, 3)), np.zeros((0, 3), int),
                np.zeros((0, 1), int), np.zeros((0, 1)))
     res = retarget_result(humanoid, "walk", bare)
-    with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
+    with mock.patch("rigedit.rigging.retarget.pipeline.hold_soles", _passthrough):
         joints = retarget_result(humanoid, "walk", bare)
     np.testing.assert_array_equal(res.mats, joints.mats)
 
@@ -168,7 +168,7 @@ def test_foot_without_skin_warns_and_keeps_the_joints(humanoid):
         res = retarget_result(humanoid, "walk", target)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
+        with mock.patch("rigedit.rigging.retarget.pipeline.hold_soles", _passthrough):
             joints = retarget_result(humanoid, "walk", target)
     np.testing.assert_array_equal(res.mats, joints.mats)
 
@@ -226,7 +226,7 @@ def test_soles_left_off_the_floor_are_reported(quadruped):
     """With one round only, the half-cannon-weighted hooves (see above) stay off: one
     warning says how far and in how many frames, never a silent result."""
     target = box_hooves(quadruped)
-    with mock.patch("rigedit.rigging.soles.ROUNDS", 1):
+    with mock.patch("rigedit.rigging.retarget.soles.ROUNDS", 1):
         with pytest.warns(UserWarning, match=r"skinned soles stay up to [0-9.]+ mm off"):
             retarget_result(quadruped, "walk", target)
 
@@ -238,21 +238,21 @@ def test_a_target_without_a_binding_keeps_the_joints(humanoid):
 
     snap = SimpleNamespace(skeleton=humanoid.skeleton, clips=dict(humanoid.clips))
     res = retarget_result(humanoid, "walk", snap)
-    with mock.patch("rigedit.rigging.retarget.hold_soles", _passthrough):
+    with mock.patch("rigedit.rigging.retarget.pipeline.hold_soles", _passthrough):
         joints = retarget_result(humanoid, "walk", snap)
     np.testing.assert_array_equal(res.mats, joints.mats)
 
 
 def test_pitched_soles_turn_the_foot_not_the_leg(humanoid):
     """Long toes through the floor in the swing: the foot turns about its ankle
-    (:func:`rigedit.rigging.soles.pitch_feet`) and the legs keep nearer the source's
+    (:func:`rigedit.rigging.retarget.soles.pitch_feet`) and the legs keep nearer the source's
     directions than when the ankle alone is lifted, every guarantee kept. (Measured: legs
     8.7 degrees off the source's with the ankle lifted, 7.2 with the foot turned first; 4.4
     without the sole step.)"""
-    from rigedit.rigging.measure import direction_errors
+    from rigedit.rigging.retarget.measure import direction_errors
     src = rigedit.load_rig(BANDAI_WALK)
     target = deep_heels(humanoid, toes=0.25)
-    with mock.patch("rigedit.rigging.soles.PITCH", 0.0):
+    with mock.patch("rigedit.rigging.retarget.soles.PITCH", 0.0):
         lifted = retarget_result(src, "take", target)
     turned = retarget_result(src, "take", target)
     before, after = direction_errors(lifted)["legs"], direction_errors(turned)["legs"]

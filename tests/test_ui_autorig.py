@@ -197,7 +197,7 @@ def test_bad_mesh_keeps_the_open_document_and_names_the_file(window, qtbot, monk
 
 
 def test_status_line_from_report():
-    from rigedit.rigging.orient import Orientation
+    from rigedit.rigging.autorig.orient import Orientation
     from rigedit.ui.autorig_dialog import describe_report
 
     report = SimpleNamespace(
@@ -238,7 +238,7 @@ def test_result_without_report_still_opens(window, qtbot, monkeypatch, small_hum
 
 def test_not_sure_result_says_why_and_selects_the_joint_in_doubt(window, qtbot, monkeypatch,
                                                                  small_humanoid_obj):
-    from rigedit.rigging.orient import Orientation
+    from rigedit.rigging.autorig.orient import Orientation
 
     w = window
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rigedit.document import Document
-from rigedit.ui.drag import DragController, DragSettings, constrain
+from rigedit.editor.document import Document
+from rigedit.editor.drag import DragController, DragSettings, constrain
 from rigedit.ui.fallback import demo_rig
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rigedit.document import Document
+from rigedit.editor.document import Document
 from rigedit.ui import rebind as rebind_module
 from rigedit.ui.fallback import demo_rig
 from rigedit.ui.rebind import RestRebind

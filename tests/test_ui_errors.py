@@ -65,7 +65,7 @@ def test_exception_in_a_qt_slot_is_shown_logged_and_saved(editor, cache, monkeyp
     assert "raise ZeroDivisionError" in log and "reset_pose" in log
     # The editor goes on: the work is still there and written for recovery.
     assert editor.isVisible() and doc.modified
-    from rigedit import recovery
+    from rigedit.editor import recovery
 
     [entry] = recovery.list_entries()
     np.testing.assert_array_equal(np.array(entry.info["pose"]), doc.pose_snapshot())
@@ -139,7 +139,7 @@ def test_describe_names_the_innermost_rigedit_frame_on_one_line():
     from rigedit.ui.errors_hook import describe
 
     def outer():
-        from rigedit.document import skeleton_with_moved_joint
+        from rigedit.editor.document import skeleton_with_moved_joint
 
         skeleton_with_moved_joint(None, 0, [np.nan, 0, 0])
 

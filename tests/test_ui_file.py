@@ -12,7 +12,7 @@ from PyQt5 import QtCore, QtWidgets  # noqa: E402
 
 from rigedit.animation import Clip, Track  # noqa: E402
 from rigedit.io.rig_folder import load_rig_folder  # noqa: E402
-from rigedit.model.weights import compute_weights  # noqa: E402
+from rigedit.binding.weights import compute_weights  # noqa: E402
 
 from ui_window_fixture import answer_file_dialog, editor_window, menu_action  # noqa: E402
 

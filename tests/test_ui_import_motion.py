@@ -12,7 +12,7 @@ pytestmark = pytest.mark.ui
 from PyQt5 import QtWidgets  # noqa: E402
 
 import rigedit  # noqa: E402
-from rigedit.rigging.calibrate import model_stack  # noqa: E402
+from rigedit.rigging.retarget.calibrate import model_stack  # noqa: E402
 
 from ui_window_fixture import answer_file_dialog, menu_action  # noqa: E402
 

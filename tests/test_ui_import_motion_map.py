@@ -15,7 +15,7 @@ pytestmark = pytest.mark.ui
 
 import rigedit  # noqa: E402
 from rigedit.rigging import load_map, retarget_result  # noqa: E402
-from rigedit.rigging.calibrate import model_stack  # noqa: E402
+from rigedit.rigging.retarget.calibrate import model_stack  # noqa: E402
 from rigedit.ui.joint_map_dialog import NONE  # noqa: E402
 
 from ui_window_fixture import answer_file_dialog, menu_action  # noqa: E402

@@ -1,7 +1,7 @@
 """Work that runs in a worker thread, through the editor's real paths: File > Recompute
 weights, its progress bar and Cancel, and the re-bind after an edit-mode drag cancelled.
 
-A slow weights method (monkeypatched into ``rigedit.model.weights.METHODS``, which every
+A slow weights method (monkeypatched into ``rigedit.binding.weights.METHODS``, which every
 weights computation goes through) makes the jobs last long enough to watch and cancel."""
 import time
 
@@ -10,8 +10,8 @@ import pytest
 
 pytestmark = [pytest.mark.ui, pytest.mark.filterwarnings("error::RuntimeWarning")]
 
-from rigedit.model import weights as weights_module  # noqa: E402
-from rigedit.model.weights import compute_weights  # noqa: E402
+from rigedit.binding import weights as weights_module  # noqa: E402
+from rigedit.binding.weights import compute_weights  # noqa: E402
 
 from ui_window_fixture import limb_joint, menu_action  # noqa: E402
 

@@ -212,7 +212,7 @@ def test_result_for_a_replaced_skeleton_is_dropped(window, qtbot, gate):
 
 
 def test_recomputed_weights_for_an_undone_skeleton_are_dropped(window, qtbot, gate):
-    from rigedit.document import skeleton_with_moved_joint
+    from rigedit.editor.document import skeleton_with_moved_joint
 
     doc = window.document
     j = limb_joint(doc.skeleton)

@@ -11,7 +11,7 @@ pytest.importorskip("pytestqt")
 sys.path.insert(0, str(Path(__file__).parent))
 from ui_window_fixture import demo_window, rig_template, window  # noqa: E402,F401
 
-from rigedit.model.weight_paint import joint_column  # noqa: E402
+from rigedit.binding.weight_paint import joint_column  # noqa: E402
 
 
 def mouse(widget, kind, xy, ctrl=False):

@@ -10,7 +10,7 @@ pytest.importorskip("pytestqt")
 sys.path.insert(0, str(Path(__file__).parent))
 from ui_window_fixture import demo_window, menu_action  # noqa: E402,F401
 
-from rigedit.model.weights import compute_weights  # noqa: E402
+from rigedit.binding.weights import compute_weights  # noqa: E402
 
 
 def _twist(window):

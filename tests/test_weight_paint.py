@@ -1,9 +1,9 @@
-"""Weight brush maths (rigedit.model.weight_paint): only vertices under the brush change, rows
+"""Weight brush maths (rigedit.binding.weight_paint): only vertices under the brush change, rows
 sum to 1, locked joints keep their weights, smooth evens out, the mirror dab."""
 import numpy as np
 import pytest
 
-from rigedit.model.weight_paint import (brush_vertices, falloff, joint_column, mirror_vertices,
+from rigedit.binding.weight_paint import (brush_vertices, falloff, joint_column, mirror_vertices,
                                         paint, paint_mirrored, vertex_adjacency)
 
 

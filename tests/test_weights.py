@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from builders import chain_skeleton, cylinder
-from rigedit.model.weights import compute_weights, point_segment_distance
+from rigedit.binding.weights import compute_weights, point_segment_distance
 
 
 def test_point_segment_distance_matches_brute_force():

@@ -19,7 +19,7 @@ import numpy as np
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
-from ..model.laplacian import face_areas
+from ..binding.laplacian import face_areas
 
 __all__ = ["DistanceField", "distance_field", "surface_samples", "line_winding"]
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model.laplacian import face_areas
+from ..binding.laplacian import face_areas
 from .distance import distance_field
 from .fit import W_SCALE_FIRM, W_SCALE_WEAK, fit_joints
 from .graph import medial_graph

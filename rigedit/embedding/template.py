@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.laplacian import face_areas
+from ..binding.laplacian import face_areas
 
 __all__ = ["ReducedTemplate", "reduce_template", "SHORT", "REQUIRED"]
 

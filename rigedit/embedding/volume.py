@@ -38,7 +38,7 @@ import numpy as np
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
-from ..model.laplacian import face_areas
+from ..binding.laplacian import face_areas
 from .distance import surface_samples
 
 __all__ = ["VolumeProxy", "volume_proxy", "NoVolumeError", "RESOLUTION", "MIN_VOTES",

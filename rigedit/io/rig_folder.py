@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RigFileError
-from ..model.weights import default_method
+from ..binding.weights import default_method
 from ..rig import Rig
 from .clip_json import load_clip
 from .frames import change_axes, resolve_folder_frames

@@ -11,7 +11,7 @@ of the knee takes the knee's skin, a carrier root at the ground owns segments th
 
 :func:`helper_joints` returns a reason for each joint it flags. It needs no mesh; the only
 judgement that does (is a root-at-the-ground's bone outside the body?) is left to
-:func:`rigedit.model.tails.deforming_joints`, which takes :func:`carrier_candidates` from here.
+:func:`rigedit.binding.tails.deforming_joints`, which takes :func:`carrier_candidates` from here.
 Pure numpy; nothing here imports the rest of rigedit.
 """
 from __future__ import annotations
@@ -102,7 +102,7 @@ def carrier_candidates(names, parents, heads):
     ``joint_Root``...), or when it sits at the model origin or on the edge of the box of its
     descendants (no further in than 2% of the box along some axis: on the ground under the
     feet, not inside the body as a hip root is). Whether it really is one needs the mesh
-    (its bones outside the body); see :func:`rigedit.model.tails.deforming_joints`.
+    (its bones outside the body); see :func:`rigedit.binding.tails.deforming_joints`.
     """
     parents = np.asarray(parents)
     heads = np.asarray(heads, dtype=np.float64)

@@ -6,7 +6,7 @@ cosines in the plane of the base, the middle point and the target; :func:`fabrik
 
 Written on Python floats rather than numpy rows: a drag step moves three to six points, and at
 that size numpy's per-call overhead (a few microseconds for each ``np.linalg.norm`` of a
-3-vector) is most of the cost. :func:`rigedit.rigging.contacts.two_bone_ik` solves the same
+3-vector) is most of the cost. :func:`rigedit.rigging.retarget.contacts.two_bone_ik` solves the same
 two-bone problem with numpy arrays over all the frames of a clip at once (retargeting).
 """
 from __future__ import annotations

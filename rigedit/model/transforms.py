@@ -8,8 +8,15 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-__all__ = ["compose_trs", "decompose_trs", "euler_to_quat", "quat_to_euler",
+__all__ = ["unit", "compose_trs", "decompose_trs", "euler_to_quat", "quat_to_euler",
            "translation_matrix", "normalize_quats", "quat_multiply", "tangents"]
+
+
+def unit(v, eps=1e-12):
+    """Unit vectors (..., 3) -> (..., 3) along the last axis; zero vectors stay zero."""
+    v = np.asarray(v, dtype=np.float64)
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return np.where(n > eps, v / np.maximum(n, eps), 0.0)
 
 
 def compose_trs(translation, rotation, scale=None):

@@ -1,21 +1,15 @@
-"""Rigging above the model: auto-rigging, joint mapping and motion retargeting (numpy +
-scipy).
+"""Rigging above the model, in two halves: :mod:`.autorig` (any mesh to an animated
+character) and :mod:`.retarget` (a clip from one skeleton onto another). numpy + scipy.
 
-- :mod:`.autorig`: any mesh to an animated character (:mod:`.mesh_check`, :mod:`.orient`
-  with :mod:`.mirror` and :mod:`.ground`, :mod:`.templates`, then
-  :mod:`rigedit.embedding`); :mod:`.autorig_command` is the CLI's part.
-- :mod:`.name_map`: canonical humanoid slots from names and tree structure, joint maps.
-- :mod:`.limbs`: legs of any skeleton found by structure (quadrupeds and others);
-  :mod:`.tree_map`: a joint map from the trees' shape.
-- :mod:`.retarget`: transfer a clip between skeletons with different rest poses and sizes
-  (:mod:`.calibrate`, :mod:`.transfer`, :mod:`.chains`, :mod:`.pitch`, :mod:`.bake`);
-  :mod:`.measure`: its quality measures; :mod:`.command`: the CLI's part.
-- :mod:`.contacts`: foot contacts in the source, leg IK clean-up on the target.
+The halves are subpackages of ``rigging`` rather than top-level packages because
+``rigedit.autorig`` and ``rigedit.retarget`` are the API's functions (a subpackage of the same
+name would replace them on the package). The names below are the public ones this package has
+always exported.
 """
 from __future__ import annotations
 
-from .name_map import auto_map, find_slots, load_map, save_map
-from .retarget import RetargetResult, retarget, retarget_result
+from .retarget.name_map import auto_map, find_slots, load_map, save_map
+from .retarget.pipeline import RetargetResult, retarget, retarget_result
 
 __all__ = ["retarget", "retarget_result", "RetargetResult", "auto_map", "find_slots", "load_map",
            "save_map"]

@@ -38,7 +38,7 @@ def template_path(path):
 
 def describe_report(report):
     """One line for the status bar from ``rig.autorig_report``
-    (:class:`rigedit.rigging.autorig.AutorigReport`): NOT SURE and the first reason when a
+    (:class:`rigedit.rigging.autorig.pipeline.AutorigReport`): NOT SURE and the first reason when a
     check failed, the orientation used and whether it was guessed (and sure), the template
     clips that came along, and each stage's time.
 
@@ -48,7 +48,7 @@ def describe_report(report):
     """
     if report is None:
         return ""
-    from ..rigging.orient import axis_name
+    from ..rigging.autorig.orient import axis_name
 
     o = report.orientation
     how = "given" if not o.guessed else ("guessed" if o.sure else

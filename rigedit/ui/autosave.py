@@ -2,7 +2,7 @@
 recovery entry in the user's cache folder every few minutes when it changed, and at once on
 an unexpected error or a termination signal; the next start offers to recover what an
 editor that is no longer running left behind. Where and how entries are written is
-:mod:`rigedit.recovery` (pure); this module holds the timer, the signals and the dialog.
+:mod:`rigedit.editor.recovery` (pure); this module holds the timer, the signals and the dialog.
 
 The interval is ``RIGEDIT_AUTOSAVE_SECONDS`` (default 120; 0 turns the timer off, the
 crash and signal saves stay). The timer's writes run in a thread (a bundled character's
@@ -20,7 +20,7 @@ import threading
 
 from PyQt5 import QtCore, QtWidgets
 
-from .. import recovery
+from ..editor import recovery
 from ..errors import RigFileError
 from . import errors_hook
 

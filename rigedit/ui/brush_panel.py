@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from PyQt5 import QtCore, QtWidgets
 
-from ..model.weight_paint import MODES
+from ..binding.weight_paint import MODES
 
 __all__ = ["BrushPanel"]
 

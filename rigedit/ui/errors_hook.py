@@ -5,7 +5,7 @@ when the hook is Python's default one); VTK observers and job completion callbac
 theirs through :func:`report`. Each one is
 
 - logged with its traceback to ``rigedit.log`` in the user's cache folder
-  (:func:`rigedit.recovery.log_path`; the traceback goes there only),
+  (:func:`rigedit.editor.recovery.log_path`; the traceback goes there only),
 - shown to the user by the newest live editor window (``window.show_unexpected_error``:
   a red status message naming what failed and a non-modal dialog; the window also writes a
   recovery snapshot, as the state after an unexpected error may not be trustworthy),
@@ -26,7 +26,7 @@ import traceback
 
 from PyQt5 import QtWidgets
 
-from .. import recovery
+from ..editor import recovery
 
 __all__ = ["install", "uninstall", "report", "describe", "logger", "enable_faulthandler",
            "ErrorDisplay"]
@@ -38,7 +38,7 @@ _faults = None     # the file faulthandler writes to
 
 
 def logger():
-    """The ``rigedit`` logger, writing to :func:`rigedit.recovery.log_path` (1 MB, one
+    """The ``rigedit`` logger, writing to :func:`rigedit.editor.recovery.log_path` (1 MB, one
     older file kept). When the cache folder cannot be written the log goes nowhere rather
     than failing the editor."""
     path = recovery.log_path()

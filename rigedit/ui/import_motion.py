@@ -19,7 +19,7 @@ from types import SimpleNamespace
 from PyQt5 import QtWidgets
 
 from ..animation.clip_names import check_clip_name
-from ..rigging.name_map import unmapped_parts
+from ..rigging.retarget.name_map import unmapped_parts
 
 __all__ = ["ImportMotion", "motion_path"]
 

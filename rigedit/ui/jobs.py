@@ -10,7 +10,7 @@ import threading
 
 from PyQt5 import QtCore
 
-from ..model.weights import compute_weights, default_method
+from ..binding.weights import compute_weights, default_method
 
 __all__ = ["Cancelled", "Job", "JobsMixin", "weights_in_chunks"]
 

@@ -1,6 +1,6 @@
 """The editor window: 3D view with joint gizmos, joint and info panels, menus, undo.
 
-Data flow: user input -> :class:`~rigedit.document.Document` methods -> document events ->
+Data flow: user input -> :class:`~rigedit.editor.document.Document` methods -> document events ->
 :meth:`MainWindow._on_document` refreshes the views. Widgets never talk to each other.
 """
 from __future__ import annotations
@@ -12,14 +12,14 @@ import numpy as np
 from PyQt5 import QtCore, QtWidgets
 from pyvistaqt import QtInteractor
 
-from ..document import Document
+from ..editor.document import Document
 from ..render.axis_handles import AxisHandles
 from ..render.joint_gizmos import JointGizmos, gizmo_radius
 from ..render.overlay import overlay_renderer
 from ..render.scene import RigScene
 from . import errors_hook
 from .autosave import Autosave, confirm_unsaved_changes
-from .drag import DragController, DragSettings
+from ..editor.drag import DragController, DragSettings
 from .menus import MenusMixin
 from .file_actions import FileActions
 from .joint_panel import InfoPanel, JointPanel

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from PyQt5 import QtCore
 
-from ..document import skeleton_with_moved_joint
+from ..editor.document import skeleton_with_moved_joint
 from .jobs import weights_in_chunks
 
 __all__ = ["RestRebind"]

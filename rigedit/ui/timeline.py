@@ -4,10 +4,10 @@ Data flow (docs/architecture.md): the ruler paints and reports mouse gestures; t
 into document calls. Time goes through ``Document.set_time``; on the document's ``"time"``
 event the dock samples the current clip and shows the pose with ``Document.set_pose`` (no
 undo step), so scrubbing, playback and scripts all take the same path and the 3D view and
-gizmos follow. Key edits (:class:`~rigedit.ui.timeline_keys.KeyEditor`, the dock's
+gizmos follow. Key edits (:class:`~rigedit.editor.timeline_keys.KeyEditor`, the dock's
 :attr:`~TimelineDock.keys`) and clip edits (:class:`~rigedit.ui.timeline_clips.ClipManager`,
-:attr:`~TimelineDock.clip_manager`) are :class:`~rigedit.document.Command` objects on the
-document's undo stack, one per user action (:mod:`rigedit.ui.timeline_edits`).
+:attr:`~TimelineDock.clip_manager`) are :class:`~rigedit.editor.document.Command` objects on the
+document's undo stack, one per user action (:mod:`rigedit.editor.timeline_edits`).
 
 Playback is driven by elapsed time (:class:`~rigedit.animation.playback.PlaybackClock` fed
 with ``time.perf_counter``) from a QTimer: a slow frame skips ahead.
@@ -21,8 +21,8 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 from ..animation.interpolate import ROTATION_MODES, VECTOR_MODES
 from ..animation.playback import PlaybackClock
 from .timeline_clips import ClipManager
-from .timeline_edits import ClipEdits
-from .timeline_keys import KeyEditor
+from ..editor.timeline_edits import ClipEdits
+from ..editor.timeline_keys import KeyEditor
 from .timeline_ruler import TimelineRuler
 
 __all__ = ["TimelineDock", "TimelineRuler"]

@@ -1,6 +1,6 @@
 """The timeline's clip list: new, add, rename, duplicate and delete a clip, its duration.
 
-Each is one undo step (:class:`~rigedit.ui.timeline_edits.ClipEdits`); names are checked
+Each is one undo step (:class:`~rigedit.editor.timeline_edits.ClipEdits`); names are checked
 as everywhere a clip is made (:mod:`rigedit.animation.clip_names`) and a refused name is
 reported, not raised.
 """

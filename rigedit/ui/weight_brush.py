@@ -1,6 +1,6 @@
 """The weight brush: painting the selected joint's skin weights in the weight paint view.
 
-The maths is :mod:`rigedit.model.weight_paint`; this module turns mouse events of the 3D view
+The maths is :mod:`rigedit.binding.weight_paint`; this module turns mouse events of the 3D view
 into dabs. A left-button press on the mesh (brush on) starts a stroke, each mouse move paints
 one dab where the mouse ray meets the shown (skinned) surface, and the release makes the whole
 stroke one undo step (:meth:`Document.set_weights`). The brush radius is in screen pixels:
@@ -20,12 +20,12 @@ from __future__ import annotations
 import numpy as np
 from PyQt5 import QtWidgets
 
-from ..model.weight_paint import mirror_vertices, vertex_adjacency
+from ..binding.weight_paint import mirror_vertices, vertex_adjacency
 from ..render.brush_circle import BrushCircle
 from ..render.observers import add_mouse_observers
 from ..render.surface_pick import SurfacePicker, nearest_vertex, world_radius
 from .brush_panel import BrushPanel
-from .weight_stroke import WeightStroke
+from ..editor.weight_stroke import WeightStroke
 
 __all__ = ["BrushPanel", "WeightBrush", "install_weight_brush"]
 
