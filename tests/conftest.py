@@ -10,7 +10,18 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp(prefix="rigedit-test-cache-")
 atexit.register(shutil.rmtree, os.environ["XDG_CACHE_HOME"], True)
 
+import sys
+from pathlib import Path
+
 import pytest
+
+# Tests sit in folders mirroring the packages (tests/model/, tests/io/, ...) and some share
+# tables by importing another test module by name (``from test_gltf import SAMPLES``): every
+# folder is importable, whatever order pytest collects them in.
+for _folder in sorted(p for p in Path(__file__).resolve().parent.rglob("*")
+                      if p.is_dir() and p.name != "__pycache__"):
+    if str(_folder) not in sys.path:
+        sys.path.append(str(_folder))
 
 # The editor window fixture (`window`, `demo_window`, `rig_template`) for the UI tests.
 pytest_plugins = ["ui_window_fixture"]

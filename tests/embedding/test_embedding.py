@@ -6,6 +6,7 @@ most 4% on every test mesh. Heavy inputs are built once per module.
 """
 from __future__ import annotations
 
+from testpaths import REPO
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +15,7 @@ import pytest
 import rigedit
 from rigedit.embedding import Embedding, EmbeddingError, cd_j2j, embed_skeleton
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+DATA = REPO.parent / "shared" / "data"
 
 
 # ------------------------------------------------------------------------------ helpers

@@ -1,4 +1,5 @@
 """``python app.py --screenshot OUT.png`` renders the window and exits; a bad rig fails clearly."""
+from testpaths import REPO
 import os
 import subprocess
 import sys
@@ -8,7 +9,7 @@ import numpy as np
 import pytest
 
 pytestmark = pytest.mark.ui
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = REPO
 
 
 def test_app_screenshot(tmp_path):

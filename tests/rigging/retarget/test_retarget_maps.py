@@ -4,6 +4,7 @@ fingers onto fingers, the same skeleton mapping the same way in every file, and 
 (an error with --strict) for a map that leaves a limb, the spine or the head unmapped."""
 from __future__ import annotations
 
+from testpaths import REPO
 import json
 import subprocess
 import sys
@@ -21,7 +22,6 @@ from rigedit.rigging.retarget.calibrate import calibrate
 from rigedit.rigging.retarget.measure import direction_errors
 from rigedit.rigging.retarget.name_map import find_slots, finger_pairs, unmapped_parts
 
-REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"
 ICLONE = DATA / "bvh-library" / "cmu-iclone"
 XBOT = DATA / "threejs-characters" / "Xbot.glb"

@@ -2,6 +2,7 @@
 proportions, rest poses and joint names (a JSON map), legs found by structure, bad input."""
 from __future__ import annotations
 
+from testpaths import REPO
 import json
 import subprocess
 import sys
@@ -21,9 +22,6 @@ from rigedit.rigging.retarget.measure import (direction_errors, foot_slip, lowes
                                      source_foot_points, target_foot_points)
 
 from quadruped_variants import VARIANTS, fore_variant, renamed, variant
-
-REPO = Path(__file__).resolve().parents[1]
-
 
 @pytest.fixture(scope="module")
 def quad():

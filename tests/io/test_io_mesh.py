@@ -1,3 +1,4 @@
+from testpaths import REPO
 import numpy as np
 import pytest
 
@@ -65,7 +66,7 @@ def test_missing_and_unknown_format(tmp_path):
 def test_real_models_load():
     from pathlib import Path
 
-    data = Path(__file__).resolve().parents[2] / "shared" / "data" / "common-3d-test-models"
+    data = REPO.parent / "shared" / "data" / "common-3d-test-models"
     if not data.is_dir():
         pytest.skip("shared test data not present")
     v, f = load_mesh(data / "homer.obj")

@@ -7,6 +7,7 @@ skeletons ignored. A flat sheet and a point cloud are still refused, naming the 
 """
 from __future__ import annotations
 
+from testpaths import REPO
 import warnings
 from pathlib import Path
 
@@ -20,7 +21,7 @@ from rigedit.errors import RigFileError
 from rigedit.io.mesh import save_obj
 from rigedit.rigging.autorig.mesh_check import MAX_HOLE, MAX_OPEN_AREA, check_mesh
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+DATA = REPO.parent / "shared" / "data"
 
 
 @pytest.fixture(scope="module")

@@ -1,6 +1,7 @@
 """rigging.mesh_check: what an auto-rigged mesh may be, and the one error otherwise."""
 from __future__ import annotations
 
+from testpaths import REPO
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +13,7 @@ from rigedit.errors import RigFileError
 from rigedit.io.mesh import save_obj
 from rigedit.rigging.autorig.mesh_check import MAX_HOLE, check_mesh, read_mesh
 
-CESIUM = Path(__file__).resolve().parents[2] / "shared" / "data" / "khronos-gltf" / \
+CESIUM = REPO.parent / "shared" / "data" / "khronos-gltf" / \
     "CesiumMan.glb"
 
 

@@ -1,6 +1,7 @@
 """Retargeting: joint maps, bone directions, contacts and floor, identity, bad input."""
 from __future__ import annotations
 
+from testpaths import REPO
 import json
 import subprocess
 import sys
@@ -20,7 +21,6 @@ from rigedit.rigging.retarget.measure import direction_errors
 from rigedit.rigging.retarget.name_map import find_slots, normalise_name
 from rigedit.rigging.retarget.soles import sole_measures
 
-REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"
 CMU = DATA / "bvh-cmu" / "131_01.bvh"
 WALK = DATA / "bvh-bandai" / "dataset-1_walk_normal_002.bvh"

@@ -1,6 +1,7 @@
 """File > Import motion onto this character, through the real menu action on the bundled
 humanoid under Xvfb (only the file dialog is replaced): the Bandai walk becomes one new clip
 that moves, as one undo step; a broken BVH changes nothing and names the file."""
+from testpaths import REPO
 import warnings
 from pathlib import Path
 
@@ -16,7 +17,7 @@ from rigedit.rigging.retarget.calibrate import model_stack  # noqa: E402
 
 from ui_window_fixture import answer_file_dialog, menu_action  # noqa: E402
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+DATA = REPO.parent / "shared" / "data"
 WALK = DATA / "bvh-bandai" / "dataset-1_walk_normal_002.bvh"
 
 

@@ -3,6 +3,7 @@ the floor during contacts, never below it, not sliding; a rig without a mesh kee
 joints' clean-up."""
 from __future__ import annotations
 
+from testpaths import REPO
 import warnings
 from pathlib import Path
 from unittest import mock
@@ -18,7 +19,7 @@ from rigedit.rigging.retarget.soles import (find_soles, hold_offsets, raise_body
                                    sole_measures, sole_slip, standing,
                                    vertex_heights)
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+DATA = REPO.parent / "shared" / "data"
 BANDAI_WALK = DATA / "bvh-bandai" / "dataset-1_walk_normal_002.bvh"
 
 

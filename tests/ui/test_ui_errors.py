@@ -6,6 +6,7 @@ bar never shows); the editor keeps running and writes a recovery snapshot.
 pytest-qt normally installs its own excepthook for each test (and fails the test on any
 exception in a slot); these tests turn that off so the editor's hook is the one that runs.
 """
+from testpaths import TESTS
 import sys
 import warnings
 
@@ -163,7 +164,7 @@ def test_window_fixture_still_fails_a_test_whose_vtk_callback_raised(tmp_path):
     import subprocess
     from pathlib import Path
 
-    tests = Path(__file__).resolve().parent
+    tests = TESTS
     (tmp_path / "conftest.py").write_text('pytest_plugins = ["ui_window_fixture"]\n')
     (tmp_path / "test_broken_callback.py").write_text(
         "import numpy as np\n\n\n"

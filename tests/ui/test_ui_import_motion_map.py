@@ -3,6 +3,7 @@ bundled humanoid under Xvfb (only the file dialogs are replaced): the map used i
 as JSON that ``rigedit retarget --map`` reads, edited in the table (an unmapped joint then
 keeps its rest pose in the clip), loaded from a file; bad maps name the file and add nothing.
 """
+from testpaths import REPO
 import json
 import warnings
 from pathlib import Path
@@ -20,7 +21,7 @@ from rigedit.ui.joint_map_dialog import NONE  # noqa: E402
 
 from ui_window_fixture import answer_file_dialog, menu_action  # noqa: E402
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+DATA = REPO.parent / "shared" / "data"
 WALK = DATA / "bvh-bandai" / "dataset-1_walk_normal_002.bvh"
 
 

@@ -11,6 +11,7 @@ figure before it).
 """
 from __future__ import annotations
 
+from testpaths import REPO
 import re
 from pathlib import Path
 
@@ -20,7 +21,7 @@ import pytest
 import rigedit
 from rigedit.embedding import cd_j2j, embed_skeleton
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+DATA = REPO.parent / "shared" / "data"
 
 ARM = ("ForeArm", "Hand")
 #: Humanoid variants: (offset factors by joint, scales by joint, Euler degrees by joint).

@@ -2,6 +2,7 @@
 changes, a clean close leaves nothing, an editor that dies (an unexpected exception, SIGTERM,
 or SIGKILL after an autosave) leaves an entry that the next start offers, and recovering
 brings back the edited pose and clip as an unsaved document."""
+from testpaths import REPO
 import json
 import os
 import signal
@@ -14,7 +15,7 @@ import numpy as np
 import pytest
 
 pytestmark = pytest.mark.ui
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = REPO
 
 from cache_fixture import cache  # noqa: E402,F401 - the fixture
 

@@ -1,6 +1,7 @@
 """Whole-folder saves (rigedit.io.rig_save): the folder matches the rig, files rigedit did not
 write stay, clip names are checked, a killed save leaves the old or the new state, bundled
 characters are read-only."""
+from testpaths import TESTS
 import json
 import os
 import random
@@ -25,7 +26,7 @@ from rigedit.io.rig_folder import load_rig_folder, save_rig_folder
 from rigedit.io.rig_save import JOURNAL, STAGING, is_bundled, recover_interrupted_save
 from save_crash_child import rig_state
 
-HERE = Path(__file__).resolve().parent
+HERE = TESTS
 
 
 def load(folder):

@@ -1,6 +1,7 @@
 """glTF in: rigedit's skinning of glTF files against an independent reading of the spec."""
 from __future__ import annotations
 
+from testpaths import REPO
 import json
 import warnings
 from pathlib import Path
@@ -13,7 +14,7 @@ from gltf_reference import Reference
 from rigedit.errors import RigFileError
 from rigedit.io.gltf_read import GltfWarning, load_gltf, unique_names
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "khronos-gltf"
+DATA = REPO.parent / "shared" / "data" / "khronos-gltf"
 SAMPLES = ["CesiumMan.glb", "RiggedFigure.glb", "RiggedSimple.glb", "SimpleSkin.gltf"]
 
 

@@ -1,4 +1,5 @@
 """BVH in: poses checked against an independent reading of the format written here."""
+from testpaths import REPO
 import warnings
 from pathlib import Path
 
@@ -9,7 +10,7 @@ import rigedit
 from rigedit.errors import RigFileError
 from rigedit.io.bvh import BvhUnitsWarning, believable, guess_unit, load_bvh
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+DATA = REPO.parent / "shared" / "data"
 FILES = ["bvh-cmu/131_01.bvh", "bvh-bandai/dataset-1_walk_normal_002.bvh",
          "bvh-bandai/dataset-1_run_normal_001.bvh"]
 

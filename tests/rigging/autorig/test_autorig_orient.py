@@ -1,6 +1,7 @@
 """rigging.orient: up and forward recovered from meshes turned every way (or "not sure")."""
 from __future__ import annotations
 
+from testpaths import REPO
 import itertools
 from pathlib import Path
 
@@ -12,7 +13,7 @@ import rigedit
 from rigedit.rigging.autorig.mesh_check import read_mesh
 from rigedit.rigging.autorig.orient import axis_name, check_axes, orient, parse_axis
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "common-3d-test-models"
+DATA = REPO.parent / "shared" / "data" / "common-3d-test-models"
 
 # (mesh, upright template, true up, true forward) in the file's own frame
 BUNDLED = {"humanoid": (True, [0, 1, 0], [0, 0, 1]), "quadruped": (False, [0, 1, 0], [0, 0, 1])}

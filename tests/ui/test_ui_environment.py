@@ -1,6 +1,7 @@
 """The UI tests fail, never skip, when pytest-qt or an X display is missing: conftest.py
 checks before any fixture creates a QApplication (without a display Qt aborts the whole run;
 an importorskip would hide the UI suite behind a green result)."""
+from testpaths import REPO
 import os
 import subprocess
 import sys
@@ -11,7 +12,7 @@ import pytest
 
 from conftest import ui_environment_problem
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = REPO
 
 
 def test_a_ui_test_fails_without_a_display():

@@ -7,6 +7,7 @@ and a big head, and a pig-like quadruped with big ears.
 """
 from __future__ import annotations
 
+from testpaths import REPO
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -22,7 +23,7 @@ from rigedit.rigging.autorig.orient_search import MARGIN, search
 
 from test_autorig_orient import TURNS   # the 24 axis-aligned turns
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+DATA = REPO.parent / "shared" / "data"
 
 
 # ----------------------------------------------------------------------------- meshes

@@ -1,6 +1,7 @@
 """rigedit.autorig and `rigedit autorig`: the whole pipeline on meshes in foreign frames."""
 from __future__ import annotations
 
+from testpaths import REPO
 import json
 import os
 import shutil
@@ -19,7 +20,7 @@ from rigedit.io.mesh import save_obj
 from rigedit.model.skeleton import Skeleton
 from rigedit.rigging.autorig.pipeline import build_skeleton, load_template
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+DATA = REPO.parent / "shared" / "data"
 HOMER = DATA / "common-3d-test-models" / "homer.obj"
 
 # The bundled humanoid's mesh as a file would bring it: Z up, facing -X, in centimetres,

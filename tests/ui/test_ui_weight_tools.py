@@ -1,5 +1,6 @@
 """Editor toggles of issue 10: DQS/LBS in the View menu, Recompute weights with a chosen
 method, and the joint panel's per-joint "deforms" flag (real window under Xvfb)."""
+from testpaths import TESTS
 import sys
 from pathlib import Path
 
@@ -7,7 +8,7 @@ import numpy as np
 import pytest
 
 pytest.importorskip("pytestqt")
-sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(TESTS))
 from ui_window_fixture import demo_window, menu_action  # noqa: E402,F401
 
 from rigedit.binding.weights import compute_weights  # noqa: E402

@@ -6,6 +6,7 @@ and each BVH skeleton onto itself; and synthetic cases of what broke the identit
 """
 from __future__ import annotations
 
+from testpaths import REPO
 import warnings
 from pathlib import Path
 
@@ -21,7 +22,6 @@ from rigedit.rigging import retarget_result
 from rigedit.rigging.retarget.calibrate import model_stack
 from rigedit.rigging.retarget.measure import direction_errors, lowest_foot
 
-REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"
 XBOT = DATA / "threejs-characters" / "Xbot.glb"
 
