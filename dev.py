@@ -125,6 +125,13 @@ def main(argv):
         return 0
     if cmd == "test":
         env.update(gltf_validator_env())
+        # The layer contracts (.importlinter) first: an import against the architecture's
+        # arrows fails the run before any test does.
+        say("checking the layer contracts (lint-imports)")
+        if subprocess.run([str(VENV / "bin" / "lint-imports"), "--no-cache"], cwd=ROOT,
+                          env=env).returncode != 0:
+            say("an import breaks a layer contract (see above and docs/architecture.md)")
+            return 1
         say("running the tests")
         return subprocess.run([str(PY), "-m", "pytest", *rest], cwd=ROOT, env=env).returncode
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
