@@ -11,11 +11,7 @@ import scipy.sparse as sp
 
 from . import skinning_kernels
 from .dqs import dqs_skin, palette_dual_quaternions
-
-try:  # The in-place kernel behind ``csr_matrix @ dense``; lets a frame reuse its buffers.
-    from scipy.sparse._sparsetools import csr_matvecs as _csr_matvecs
-except ImportError:  # pragma: no cover - SciPy moved it; fall back to the public product
-    _csr_matvecs = None
+from .fast_paths import csr_times_dense_into
 
 __all__ = ["SkinBinding", "linear_blend_skin", "top_k_influences", "dense_weights", "METHODS",
            "BACKENDS", "vertex_normals"]
@@ -234,15 +230,8 @@ class SkinBinding:
                         self._weights32, self._palette16, res)
             return res
         self._palette[:] = np.asarray(palette)[:, :3, :].reshape(-1, 12)
-        blend = self._blend
-        w = self.matrix
-        if _csr_matvecs is not None:
-            blend.fill(0.0)
-            _csr_matvecs(w.shape[0], w.shape[1], 12, w.indptr, w.indices, w.data,
-                         self._palette.ravel(), blend.ravel())
-        else:
-            blend[:] = w @ self._palette
-        b = blend.reshape(-1, 3, 4)
+        # in place into the frame's buffer where SciPy allows it (see fast_paths)
+        b = csr_times_dense_into(self.matrix, self._palette, self._blend).reshape(-1, 3, 4)
         # res = b[:, :, :3] @ rest + b[:, :, 3], written column by column into the buffers to
         # avoid the (V, 3, 3) temporaries an einsum would make.
         r = self._rest32
