@@ -1,25 +1,25 @@
-"""The compiled dual-quaternion skinning kernel and its per-frame helpers (numba, in plain
-Python here; :class:`rigedit.model.skinning_kernels.Kernels` compiles them).
+"""The compiled dual-quaternion skinning kernel and its per-frame helpers (numba), in the form
+numba compiles: imported only by :class:`rigedit.model.skinning_kernels.Kernels`, after
+numba (this module imports it and the vector blocks of :mod:`.skinning_simd`).
 
-Nothing here imports numba: like :mod:`.skinning_kernels`, this module's globals ``prange``
-and the vector blocks of :mod:`.skinning_simd` (``_dq_blend4_into``, ``_dq_apply16``,
-``_dq_apply16_normals``) and the inlined helpers are filled in by :meth:`Kernels.__init__`
-before compiling. :mod:`rigedit.model.dqs` is the numpy reference and fallback.
+:mod:`rigedit.model.dqs` is the numpy reference and fallback. ``SIMD_SHA256`` is the
+version of ``skinning_simd.py`` this kernel inlines, as in :mod:`.lbs_kernels` (numba's disk
+cache follows this file only).
 """
 from __future__ import annotations
 
 import numpy as np
+from numba import njit, prange
 
-__all__ = ["DQS_TASK", "hemisphere_signs"]
+from .skinning_kernels import DQS_TASK, FASTMATH
+from .skinning_simd import dq_apply16 as _dq_apply16
+from .skinning_simd import dq_apply16_normals as _dq_apply16_normals
+from .skinning_simd import dq_blend4_into as _dq_blend4_into
 
-#: Vertices per parallel task of the DQS kernel (a multiple of skinning_simd.DQ_BLOCK): each
-#: task allocates its small scratch blocks once.
-DQS_TASK = 1024
+__all__ = ["SIMD_SHA256", "DQS_TASK"]
 
-# Filled in by Kernels.__init__ (numba reads module globals when it compiles).
-prange = range
-_dq_blend4_into = _dq_apply16 = _dq_apply16_normals = None
-_dqs_task = _dq_blend_block = _scale_block = _dq_apply_one = None
+#: sha256 of skinning_simd.py as this kernel was last compiled and checked against it.
+SIMD_SHA256 = "aafe0734f8842c7eb9d9e60fbb1a4424939e4cdf825df3c1bc3ebf3630323ef1"
 
 
 def _dqs_py(rest, rest_normals, indices, weights, dq, signs, scale, has_scale, out,
@@ -259,12 +259,9 @@ def _rigid_dual_quaternions_py(palette, tol, dq):
     return True
 
 
-def hemisphere_signs(dq, out):
-    """out[a, b] = -1 where joints a and b's rotation quaternions (dq[:, :4]) point into
-    opposite hemispheres, else 1: the DQS kernel's antipodality flips, once per frame.
-
-    dq : (J, 8) float32; out : (J, J) float32
-    """
-    np.matmul(dq[:, :4], dq[:, :4].T, out=out)
-    np.copysign(np.float32(1.0), out, out=out)
-    return out
+# Inlined into the DQS kernel (numba IR), so the constant flags of each call fold away.
+_INLINE = {"fastmath": FASTMATH, "inline": "always"}
+_dqs_task = njit(**_INLINE)(_dqs_task_py)
+_dq_blend_block = njit(**_INLINE)(_dq_blend_block_py)
+_scale_block = njit(**_INLINE)(_scale_block_py)
+_dq_apply_one = njit(**_INLINE)(_dq_apply_one_py)

@@ -1,18 +1,19 @@
 """Vector (SIMD) building blocks of the compiled skinning kernels, as numba intrinsics.
 
-Imported only by :class:`rigedit.model.skinning_kernels.Kernels` (it imports numba and
-llvmlite). numba 0.68 compiles the per-vertex blend of a 3x4 palette as scalar multiply-adds
-whatever the source's layout, which made LBS compute-bound at about 10 ns per vertex with four
-influences (the FMA units' scalar rate); written here directly as LLVM vector operations on
-16-float rows, a vertex's four influences are four 16-wide multiply-adds and the frame runs at
-about 3 ns per vertex, about twice the memory-copy floor (measured by
+Imported only by the kernels' sources (:mod:`.lbs_kernels`, :mod:`.dqs_kernels`; it imports
+numba and llvmlite). numba 0.68 compiles the per-vertex blend of a 3x4 palette as scalar
+multiply-adds whatever the source's layout, which made LBS compute-bound at about 10 ns per
+vertex with four influences (the FMA units' scalar rate); written here directly as LLVM
+vector operations on 16-float rows, a vertex's four influences are four 16-wide multiply-adds
+and the frame runs at about 3 ns per vertex, about twice the memory-copy floor (measured by
 ``benchmarks/bench_skinning.py``: 3.1-3.7 ms of CPU for 1M vertices against 1.5 ms for copying
 their 56 bytes each). LLVM lowers the 16-wide vectors to whatever the CPU has (AVX-512,
 two AVX halves, four SSE quarters).
 
-numba's on-disk cache of a kernel is keyed on a hash of the kernel's own source file, not of
-this one; :func:`rigedit.model.skinning_kernels._flush_if_simd_changed` keeps this file's hash
-beside the cache and rebuilds the kernels when it changes.
+numba's on-disk cache of a kernel follows the kernel's own source file, not this one: the
+kernels' files (:mod:`.lbs_kernels`, :mod:`.dqs_kernels`) name this file's sha256 as
+``SIMD_SHA256``; after editing this file, put its new hash there (the test
+``test_the_kernel_sources_name_these_vector_blocks`` prints it), which rebuilds their caches.
 
 The palette row of joint ``j`` is its skinning matrix ``K_j`` transposed and flattened:
 ``row[4 c + i] = K_j[i, c]`` (column ``c`` of the 4x4), so the blended matrix's columns are four

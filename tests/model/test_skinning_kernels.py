@@ -198,26 +198,36 @@ def test_dqs_kernel_blocks_and_their_remainders_agree_with_numpy(v, scale):
         assert np.abs(normals - ref_normals).max() <= 4e-6
 
 
-def test_a_kernel_cache_is_flushed_when_the_vector_blocks_change(tmp_path):
-    """numba's cache of a kernel knows its own file only: the hash of skinning_simd.py kept
-    beside it decides whether the cached code is still the one those intrinsics give."""
-    class Cache:
-        cache_path = str(tmp_path)
-        flushes = 0
+def test_the_kernel_sources_name_these_vector_blocks():
+    """numba's disk cache of a kernel follows the kernel's own file only: the kernels' files
+    name the skinning_simd.py they inline, so editing it means editing them (new caches)."""
+    from rigedit.model import dqs_kernels, lbs_kernels
 
-        def flush(self):
-            self.flushes += 1
+    digest = skinning_kernels.simd_sha256()
+    assert lbs_kernels.SIMD_SHA256 == dqs_kernels.SIMD_SHA256 == digest, (
+        f"skinning_simd.py changed: set SIMD_SHA256 = {digest!r} in lbs_kernels.py and "
+        "dqs_kernels.py")
+    assert skinning_kernels.cache_is_current()
 
-    class Dispatcher:
-        _cache = Cache()
-        py_func = skinning_kernels._lbs_py
 
-    d = Dispatcher()
-    skinning_kernels._flush_if_simd_changed(d)   # no hash kept yet
-    assert d._cache.flushes == 1
-    skinning_kernels._flush_if_simd_changed(d)   # the same intrinsics: the cache stays
-    assert d._cache.flushes == 1
-    (stamp,) = tmp_path.iterdir()
-    stamp.write_text("the hash of other intrinsics")
-    skinning_kernels._flush_if_simd_changed(d)
-    assert d._cache.flushes == 2 and stamp.read_text() != "the hash of other intrinsics"
+def test_vector_blocks_other_than_the_kernels_name_compile_without_the_disk_cache(
+        monkeypatch):
+    from rigedit.model import lbs_kernels
+
+    monkeypatch.setattr(lbs_kernels, "SIMD_SHA256", "the hash of other intrinsics")
+    with pytest.warns(RuntimeWarning, match="without numba's disk cache"):
+        assert not skinning_kernels.cache_is_current()
+
+
+def test_building_the_kernels_sets_no_module_names():
+    """The kernels' sources import numba and the vector blocks themselves: building a
+    Kernels object rebinds no module's globals (it once filled in prange and the blends)."""
+    import numba
+
+    from rigedit.model import dqs_kernels, lbs_kernels
+
+    modules = (skinning_kernels, lbs_kernels, dqs_kernels)
+    before = [dict(vars(m)) for m in modules]
+    kernels = skinning_kernels.Kernels(numba)
+    assert [dict(vars(m)) for m in modules] == before
+    assert kernels.lbs.py_func is lbs_kernels._lbs_py and lbs_kernels.prange is numba.prange
