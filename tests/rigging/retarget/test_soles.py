@@ -253,7 +253,7 @@ def test_pitched_soles_turn_the_foot_not_the_leg(humanoid):
     from rigedit.rigging.retarget.measure import direction_errors
     src = rigedit.load_rig(BANDAI_WALK)
     target = deep_heels(humanoid, toes=0.25)
-    with mock.patch("rigedit.rigging.retarget.soles.PITCH", 0.0):
+    with mock.patch("rigedit.rigging.retarget.sole_pitch.PITCH", 0.0):
         lifted = retarget_result(src, "take", target)
     turned = retarget_result(src, "take", target)
     before, after = direction_errors(lifted)["legs"], direction_errors(turned)["legs"]
