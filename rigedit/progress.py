@@ -14,7 +14,10 @@ job this way. Pure Python: no Qt.
 """
 from __future__ import annotations
 
-__all__ = ["Cancelled", "null_progress", "scaled", "report"]
+import inspect
+import warnings
+
+__all__ = ["Cancelled", "null_progress", "scaled", "report", "adapt", "takes_stage"]
 
 
 class Cancelled(Exception):
@@ -41,9 +44,11 @@ def scaled(progress, start, end, stage=None):
     if progress is None:
         return null_progress
 
-    def step(fraction, label=None):
+    fixed = stage
+
+    def step(fraction, stage=None):
         value = None if fraction is None else start + (end - start) * min(max(fraction, 0.0), 1.0)
-        progress(value, stage if stage is not None else label)
+        progress(value, fixed if fixed is not None else stage)
 
     return step
 
@@ -52,3 +57,60 @@ def report(progress, fraction, stage=None):
     """Call ``progress`` when there is one (a job's shorthand for the optional argument)."""
     if progress is not None:
         progress(fraction, stage)
+
+
+def takes_stage(progress):
+    """True when ``progress`` can be called as ``progress(fraction, stage)``.
+
+    A callable whose signature Python cannot read (some builtins) is taken to follow the
+    protocol.
+    """
+    try:
+        signature = inspect.signature(progress)
+    except (TypeError, ValueError):
+        return True
+    try:
+        signature.bind(0.0, None)
+    except TypeError:
+        return False
+    return True
+
+
+def adapt(progress, stage=None):
+    """``progress`` as a callable of this protocol, for a job to call as ``p(fraction, stage)``.
+
+    Kept while older callers move over: a callable that takes the fraction alone (the
+    ``progress(fraction)`` that heat, the embedding and the inverse-distance weights took
+    before this protocol) still works, wrapped to drop the stage, with a
+    ``DeprecationWarning``. A cancel it raises goes through as before.
+
+    Parameters
+    ----------
+    progress : callable or None
+        ``progress(fraction, stage)``, or the deprecated ``progress(fraction)``.
+    stage : str, optional
+        A label for calls that give none (the job's name).
+
+    Returns
+    -------
+    callable(fraction, stage=None)
+        :func:`null_progress` when ``progress`` is None.
+    """
+    if progress is None:
+        return null_progress
+    if not takes_stage(progress):
+        warnings.warn("a progress callable of one argument, progress(fraction), is deprecated: "
+                      "take progress(fraction, stage) (rigedit.progress)", DeprecationWarning,
+                      stacklevel=3)
+        one = progress
+
+        def progress(fraction, stage=None):
+            one(fraction)
+    if stage is None:
+        return progress
+    call, default = progress, stage
+
+    def labelled(fraction, stage=None):
+        call(fraction, default if stage is None else stage)
+
+    return labelled

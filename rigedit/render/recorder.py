@@ -15,8 +15,10 @@ and queues them for a writer thread that feeds ffmpeg
 """
 from __future__ import annotations
 
+import inspect
 import os
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +26,7 @@ import pyvista as pv
 
 from ..errors import RigFileError
 from ..io.atomic import check_output_folder
+from ..progress import Cancelled
 from .camera import apply_camera, figure_joints, horizontal, swept_points, turn_about
 from .floor import GRID_COLOR
 from .scene import RigScene
@@ -88,8 +91,12 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         encoder's CPU small beside the render's; ``medium`` gives smaller files slower.
     skinning : {"lbs", "dqs"}
         Linear blend or dual-quaternion skinning.
-    progress : callable(done, total) -> bool, optional
-        Called after each frame; returning False cancels (raises ``RecordingCancelled``).
+    progress : callable(fraction, stage), optional
+        :mod:`rigedit.progress`'s protocol: called after each frame with the fraction of
+        frames done and the stage ``"record"``; raising :class:`rigedit.progress.Cancelled`
+        cancels (``RecordingCancelled``, a ``Cancelled``, comes out). Deprecated but still
+        taken: the older ``progress(done, total) -> bool`` (no parameter named ``stage``),
+        called with the frames done and the total, whose False cancels.
 
     Returns
     -------
@@ -103,7 +110,7 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
     ValueError
         Bad size or frame rate.
     RecordingCancelled
-        When ``progress`` returned False; no file is left behind (an existing one is kept).
+        When ``progress`` cancelled; no file is left behind (an existing one is kept).
     """
     path = Path(path)
     if path.suffix.lower() not in VIDEO_SUFFIXES:
@@ -121,6 +128,7 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
     if clip is not None:
         clip = clip.copy()   # the editor may change its clip while we render
 
+    after_frame = _frame_callback(progress)
     _use_egl_without_display()
     plotter = pv.Plotter(off_screen=True, window_size=(width, height))
     writer = None
@@ -166,8 +174,8 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
             plotter.renderer.ResetCameraClippingRange()
             plotter.render()
             writer.append(reader.read())
-            if progress is not None and progress(i + 1, len(times)) is False:
-                raise RecordingCancelled(f"recording cancelled after {i + 1} frames")
+            if after_frame is not None:
+                after_frame(i + 1, len(times))
         writer.commit()
         writer = None
         return len(times)
@@ -175,6 +183,45 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         if writer is not None:
             writer.abort()
         plotter.close()
+
+
+def _frame_callback(progress):
+    """``after_frame(done, total)`` calling ``progress`` in its protocol (None for none),
+    which raises :class:`RecordingCancelled` when the callable cancels.
+
+    Both protocols take two arguments, so the older ``(done, total) -> bool`` is told apart
+    by its signature: a callable with a parameter named ``stage`` (or ``*args``) follows
+    :mod:`rigedit.progress`; any other callable of two arguments is the older one
+    (``DeprecationWarning``; ``rigedit.ui.record_dialog`` passes it until it moves over).
+    """
+    if progress is None:
+        return None
+    if not _is_old_frame_callback(progress):
+        def after_frame(done, total):
+            try:
+                progress(done / total, "record")
+            except RecordingCancelled:
+                raise
+            except Cancelled as exc:  # callers catching RecordingCancelled still see it
+                raise RecordingCancelled(f"recording cancelled after {done} frames") from exc
+        return after_frame
+    warnings.warn("record_clip's progress(done, total) -> bool is deprecated: take "
+                  "progress(fraction, stage) and raise rigedit.progress.Cancelled to stop",
+                  DeprecationWarning, stacklevel=3)
+
+    def after_frame_old(done, total):
+        if progress(done, total) is False:
+            raise RecordingCancelled(f"recording cancelled after {done} frames")
+    return after_frame_old
+
+
+def _is_old_frame_callback(progress):
+    try:
+        params = inspect.signature(progress).parameters.values()
+    except (TypeError, ValueError):  # no signature to read: take it as the protocol
+        return False
+    return not any(p.name == "stage" or p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD)
+                   for p in params)
 
 
 def _use_egl_without_display():

@@ -19,12 +19,14 @@ from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkUnsignedCharArray
 
 from ..io.atomic import naming_target, temp_beside
+from ..progress import Cancelled
 
 __all__ = ["VideoWriter", "ThreadedWriter", "FrameReader", "RecordingCancelled"]
 
 
-class RecordingCancelled(Exception):
-    """The progress callback asked to stop; the partial file was removed."""
+class RecordingCancelled(Cancelled):
+    """The progress callback asked to stop; the partial file was removed. A
+    :class:`rigedit.progress.Cancelled`, the one cancel of every long job."""
 
 
 class VideoWriter:

@@ -107,6 +107,36 @@ def test_an_encoder_error_in_the_writer_thread_is_raised_once_and_leaves_no_temp
     assert [p.name for p in tmp_path.iterdir()] == ["out.mp4"]
 
 
+def test_progress_follows_the_one_protocol_and_its_cancel_stops_the_recording(rig, tmp_path):
+    from rigedit.progress import Cancelled
+
+    seen = []
+    path = tmp_path / "bend.gif"
+    assert record_clip(rig, rig.clips["bend"], path, fps=8, duration=0.5, size=SIZE,
+                       progress=lambda fraction, stage: seen.append((fraction, stage))) == 4
+    assert seen == [(0.25, "record"), (0.5, "record"), (0.75, "record"), (1.0, "record")]
+
+    def cancel(fraction, stage=None):
+        if fraction >= 0.5:
+            raise Cancelled
+
+    path.write_bytes(b"old video")
+    with pytest.raises(RecordingCancelled) as info:   # what the editor catches today
+        record_clip(rig, rig.clips["bend"], path, fps=8, duration=0.5, size=SIZE,
+                    progress=cancel)
+    assert isinstance(info.value, Cancelled)          # and the one cancel of every job
+    assert path.read_bytes() == b"old video"
+    assert [p.name for p in tmp_path.iterdir()] == [path.name]
+
+
+def test_the_older_frame_callback_still_works_and_says_it_is_deprecated(rig, tmp_path):
+    seen = []
+    with pytest.warns(DeprecationWarning, match="progress\\(fraction, stage\\)"):
+        record_clip(rig, None, tmp_path / "a.gif", fps=8, duration=0.25, size=SIZE,
+                    progress=lambda done, total: seen.append((done, total)))
+    assert seen == [(1, 2), (2, 2)]
+
+
 def recorder_like_plotter(rig, zoom=1.0):
     import pyvista as pv
 
