@@ -102,12 +102,8 @@ def bare_result(source_rig, source_clip, target_rig, mapping, name, times, sourc
         joints: then ``reason`` stands as the error.
     """
     ssk, tsk = source_rig.skeleton, target_rig.skeleton
-    for sk, clips in ((ssk, [source_clip]), (tsk, list(target_rig.clips.values()))):
-        try:  # a figure with legs is no rig of a legless one's family
-            calibrate(sk, clips, "", LegCalibration)
-            return None
-        except ValueError:
-            pass
+    if _has_legs(ssk, [source_clip]) or _has_legs(tsk, list(target_rig.clips.values())):
+        return None  # a figure with legs is no rig of a legless one's family
     if mapping is None:
         mapping = name_pairs(ssk, tsk)
     src, tgt = BareCalibration(ssk, source_what), BareCalibration(tsk, target_what)
@@ -120,32 +116,9 @@ def bare_result(source_rig, source_clip, target_rig, mapping, name, times, sourc
                   f"joints) without a floor, facing or foot clean-up")
     scale = tgt.size / src.size
     smats = model_stack(ssk, source_clip, times)
-    s_rot, s_rest = rotations_of(smats), rotations_of(src.mats)
-    t_rest = rotations_of(tgt.mats)
+    quats = _turned_as_source(src, tgt, inverse, smats)
+    trans, moved = _moved_as_source(ssk, tsk, source_clip, inverse, smats, scale)
     n_frames, nj = len(times), len(tsk)
-    rot = np.empty((n_frames, nj, 3, 3))
-    for j in range(nj):
-        p = tsk.parents[j]
-        if j in inverse:
-            s = inverse[j]
-            rot[:, j] = s_rot[:, s] @ (s_rest[s].T @ t_rest[j])
-        else:  # keeps its rest relation to its parent
-            rel = t_rest[j] if p < 0 else t_rest[p].T @ t_rest[j]
-            rot[:, j] = rel if p < 0 else rot[:, p] @ rel
-    local_rot = np.array([rot[:, j] if tsk.parents[j] < 0 else
-                          np.swapaxes(rot[:, tsk.parents[j]], -1, -2) @ rot[:, j]
-                          for j in range(nj)]).swapaxes(0, 1)
-    trans = np.broadcast_to(tsk.rest_translation, (n_frames, nj, 3)).copy()
-    moved = {}
-    for (joint, channel) in source_clip.tracks:
-        s = ssk.index[joint]
-        t = next((tj for tj, sj in inverse.items() if sj == s), None)
-        if channel == "translation" and t is not None:
-            moved[t] = s
-    for t, s in moved.items():
-        local = _local_translations(ssk, smats, s)
-        trans[:, t] = tsk.rest_translation[t] + (local - ssk.rest_translation[s]) * scale
-    quats = Rotation.from_matrix(local_rot.reshape(-1, 3, 3)).as_quat().reshape(n_frames, nj, 4)
     mats = np.empty((n_frames, nj, 4, 4))
     for f in range(n_frames):
         tsk.forward(compose_trs(trans[f], quats[f], tsk.rest_scale), out=mats[f])
@@ -168,6 +141,65 @@ def bare_result(source_rig, source_clip, target_rig, mapping, name, times, sourc
                 target_calibration=tgt, facing_degrees=0.0, scale=scale, times=times,
                 source_mats=smats, raw_mats=mats, mats=mats,
                 contact=np.zeros((n_frames, 0), bool), source_floor=src.floor, pairs=pairs)
+
+
+def _has_legs(skeleton, clips):
+    """Whether :class:`LegCalibration` finds legs on ``skeleton`` (in its rest or a frame
+    of ``clips``)."""
+    try:
+        calibrate(skeleton, clips, "", LegCalibration)
+        return True
+    except ValueError:
+        return False
+
+
+def _turned_as_source(src, tgt, inverse, smats):
+    """(F, J, 4) local rotations (quaternions) of the target: each mapped joint turned in
+    model space as its source joint turns from its rest, every other joint keeping its rest
+    relation to its parent.
+
+    Parameters
+    ----------
+    src, tgt : BareCalibration
+    inverse : dict[int, int]
+        Target joint -> source joint.
+    smats : (F, Js, 4, 4) float64
+        The source's model matrices over the clip.
+    """
+    tsk = tgt.skeleton
+    s_rot, s_rest = rotations_of(smats), rotations_of(src.mats)
+    t_rest = rotations_of(tgt.mats)
+    n_frames, nj = len(smats), len(tsk)
+    rot = np.empty((n_frames, nj, 3, 3))
+    for j in range(nj):
+        p = tsk.parents[j]
+        if j in inverse:
+            s = inverse[j]
+            rot[:, j] = s_rot[:, s] @ (s_rest[s].T @ t_rest[j])
+        else:  # keeps its rest relation to its parent
+            rel = t_rest[j] if p < 0 else t_rest[p].T @ t_rest[j]
+            rot[:, j] = rel if p < 0 else rot[:, p] @ rel
+    local_rot = np.array([rot[:, j] if tsk.parents[j] < 0 else
+                          np.swapaxes(rot[:, tsk.parents[j]], -1, -2) @ rot[:, j]
+                          for j in range(nj)]).swapaxes(0, 1)
+    return Rotation.from_matrix(local_rot.reshape(-1, 3, 3)).as_quat().reshape(n_frames, nj, 4)
+
+
+def _moved_as_source(ssk, tsk, source_clip, inverse, smats, scale):
+    """``(trans, moved)``: (F, J, 3) local translations of the target, each joint whose
+    source joint the clip translates moved from its rest by the source's local offset times
+    ``scale``, the others at rest; and those joints, {target joint: source joint}."""
+    trans = np.broadcast_to(tsk.rest_translation, (len(smats), len(tsk), 3)).copy()
+    moved = {}
+    for (joint, channel) in source_clip.tracks:
+        s = ssk.index[joint]
+        t = next((tj for tj, sj in inverse.items() if sj == s), None)
+        if channel == "translation" and t is not None:
+            moved[t] = s
+    for t, s in moved.items():
+        local = _local_translations(ssk, smats, s)
+        trans[:, t] = tsk.rest_translation[t] + (local - ssk.rest_translation[s]) * scale
+    return trans, moved
 
 
 def _local_translations(skeleton, mats, j):

@@ -54,11 +54,32 @@ def end_points(mats, spec):
 
 
 def transfer_rotations(src, tgt, inverse, smats, scal, rf, contact):
-    """Model rotations (F, Jt, 3, 3) of the target pointing each mapped bone where its
-    source bone points (see the module docstring), and the measured pairs
-    ``(joint, end spec, source joint, source end spec)``. ``contact`` (humanoids): the
-    source contacts, for the feet's pitch relative to the flat foot."""
-    ssk, tsk = src.skeleton, tgt.skeleton
+    """The target's model rotations pointing each mapped bone where its source bone points
+    (see :mod:`.retarget`).
+
+    Parameters
+    ----------
+    src, tgt : Calibration or LegCalibration
+        The source's and the target's calibrations.
+    inverse : dict[int, int]
+        Target joint -> source joint.
+    smats : (F, Js, 4, 4) float64
+        The source's model matrices over the clip, turned to face as the target.
+    scal : (Js, 4, 4) float64
+        The source's calibration pose, turned alike.
+    rf : (3, 3) float64
+        That turn (applied here to the source's forward and left).
+    contact : (F, 4) bool or None
+        Humanoids: the source's contacts (left and right ankle, then toe), for the feet's
+        pitch relative to the flat foot.
+
+    Returns
+    -------
+    rot : (F, Jt, 3, 3) float64
+    pairs : list of (int, spec, int, spec)
+        The measured pairs ``(joint, end spec, source joint, source end spec)``.
+    """
+    tsk = tgt.skeleton
     s_rot, sc_rot = rotations_of(smats), rotations_of(scal)
     t_rot_c = rotations_of(tgt.mats)
     s_fwd, s_left = rf @ src.forward, rf @ src.left
@@ -87,25 +108,8 @@ def transfer_rotations(src, tgt, inverse, smats, scal, rf, contact):
             rot[:, j] = (rot[:, p] if p >= 0 else np.eye(3)) @ keep[j]
             continue
         s = inverse[j]
-        nxt = chain[chain.index(j) + 1] if j in chain and j != chain[-1] else None
-        if humanoid and j == tgt.hips:
-            nxt = tgt.slots["chest"]
-        t_spec = end_spec(tsk, tgt, j, inverse, nxt)
-        s_spec = None
-        if t_spec is not None:
-            if t_spec[0] != j:
-                s_spec = (inverse[t_spec[0]], np.zeros(3))
-            else:
-                s_spec = end_spec(ssk, src, s, set(), None)
-        vt = vs = None
-        # what carries the hips (a ground-level root) has no bone to align: its "bone" to
-        # the hips changes with the figure's proportions
-        if s_spec is not None and (j == tgt.hips or j not in above_hips):
-            vt = end_points(tgt.mats, t_spec) - tgt.points[j]
-            vs = end_points(scal, s_spec) - scal[s, :3, 3]
-            if np.linalg.norm(vt) < 1e-4 * tgt.hip_height or \
-                    np.linalg.norm(vs) < 1e-4 * src.hip_height:
-                vt = vs = None
+        t_spec, s_spec = _end_specs(src, tgt, j, s, inverse, chain)
+        vt, vs = _calibration_bones(src, tgt, scal, j, s, t_spec, s_spec, above_hips)
         if vt is not None:
             x, _ = Rotation.align_vectors([vs, s_fwd, s_left], [vt, tgt.forward, tgt.left],
                                           weights=[np.inf, 1.0, 1.0])
@@ -118,31 +122,74 @@ def transfer_rotations(src, tgt, inverse, smats, scal, rf, contact):
             u = t_rot_c[j].T @ vt
             want = end_points(smats, s_spec) - smats[:, s, :3, 3]
             if j in flat:
-                pitch = pitch_of(want[flat[j]]) if flat[j].any() else pitch_of(vs)
-                s_flat = float(np.median(pitch))
-                # a standing rest whose foot agrees with the clip's flat foot is the better
-                # measure of it (the median over contacts carries the foot's roll and curled
-                # toes: Xbot's toes stand 5-7 degrees up in its own clips): so a character's
-                # own clip keeps its feet exactly
-                if src.source == "rest" and abs(s_flat - pitch_of(vs)) < np.radians(FLAT_AGREE):
-                    s_flat = float(pitch_of(vs))
-                # a target calibrated on a clip's frame (its rest does not stand) has no known
-                # flat foot, and a foot built as the source's (the same pitch in both rests,
-                # the same length for the leg) has the source's: the foot points as the
-                # source's (CMU 131_01 onto itself: its toes point 11-18 degrees off their rest
-                # during its contacts)
-                same = tgt.source == src.source and \
-                    abs(pitch_of(vt) - pitch_of(vs)) < np.radians(SAME_FOOT) and \
-                    abs(np.linalg.norm(vt) / tgt.hip_height
-                        - np.linalg.norm(vs) / src.hip_height) < 1e-3
-                t_flat = pitch_of(vt) if tgt.source == "rest" and not same else s_flat
-                want = pitched(want, s_flat - t_flat)
+                want = _flat_foot_pitched(src, tgt, want, flat[j], vt, vs)
             r = swing(r @ u, want) @ r
             pairs.append((j, t_spec, s, s_spec))
         rot[:, j] = r
     if humanoid:
         distribute_bend(tsk, tgt, rot, inverse)
     return rot, pairs
+
+
+def _end_specs(src, tgt, j, s, inverse, chain):
+    """Where target joint ``j``'s bone and its source joint ``s``'s bone point
+    (:func:`end_spec` each, the source's to the source joint of the target's end when that
+    is another joint): ``(t_spec, s_spec)``, None where a bone has no end. ``chain``: the
+    mapped spine and neck joints in order (a chest's next joint is the neck, not an arm);
+    a humanoid's hips point to its chest."""
+    nxt = chain[chain.index(j) + 1] if j in chain and j != chain[-1] else None
+    if tgt.kind == "humanoid" and j == tgt.hips:
+        nxt = tgt.slots["chest"]
+    t_spec = end_spec(tgt.skeleton, tgt, j, inverse, nxt)
+    s_spec = None
+    if t_spec is not None:
+        if t_spec[0] != j:
+            s_spec = (inverse[t_spec[0]], np.zeros(3))
+        else:
+            s_spec = end_spec(src.skeleton, src, s, set(), None)
+    return t_spec, s_spec
+
+
+def _calibration_bones(src, tgt, scal, j, s, t_spec, s_spec, above_hips):
+    """``(vt, vs)``: the (3,) bones of target joint ``j`` and source joint ``s`` in their
+    calibration poses (``scal``: the source's (Js, 4, 4)), or ``(None, None)`` where either
+    has no bone to align: no end, one shorter than 1e-4 of the hip height, or a joint above
+    the hips (what carries them has no bone: its "bone" to the hips changes with the
+    figure's proportions)."""
+    if s_spec is None or not (j == tgt.hips or j not in above_hips):
+        return None, None
+    vt = end_points(tgt.mats, t_spec) - tgt.points[j]
+    vs = end_points(scal, s_spec) - scal[s, :3, 3]
+    if np.linalg.norm(vt) < 1e-4 * tgt.hip_height or \
+            np.linalg.norm(vs) < 1e-4 * src.hip_height:
+        return None, None
+    return vt, vs
+
+
+def _flat_foot_pitched(src, tgt, want, flat, vt, vs):
+    """A foot's or toe's source directions ``want`` (F, 3) turned by the difference of the
+    two figures' flat-foot pitches, so that the target's foot pitches from its flat foot as
+    the source's does from its own. ``flat`` (F,) bool: the source's contacts of that foot
+    (its median pitch there is the source's flat foot); ``vt``, ``vs``: the (3,) calibration
+    bones."""
+    pitch = pitch_of(want[flat]) if flat.any() else pitch_of(vs)
+    s_flat = float(np.median(pitch))
+    # a standing rest whose foot agrees with the clip's flat foot is the better measure of
+    # it (the median over contacts carries the foot's roll and curled toes: Xbot's toes
+    # stand 5-7 degrees up in its own clips): so a character's own clip keeps its feet
+    # exactly
+    if src.source == "rest" and abs(s_flat - pitch_of(vs)) < np.radians(FLAT_AGREE):
+        s_flat = float(pitch_of(vs))
+    # a target calibrated on a clip's frame (its rest does not stand) has no known flat
+    # foot, and a foot built as the source's (the same pitch in both rests, the same length
+    # for the leg) has the source's: the foot points as the source's (CMU 131_01 onto
+    # itself: its toes point 11-18 degrees off their rest during its contacts)
+    same = tgt.source == src.source and \
+        abs(pitch_of(vt) - pitch_of(vs)) < np.radians(SAME_FOOT) and \
+        abs(np.linalg.norm(vt) / tgt.hip_height
+            - np.linalg.norm(vs) / src.hip_height) < 1e-3
+    t_flat = pitch_of(vt) if tgt.source == "rest" and not same else s_flat
+    return pitched(want, s_flat - t_flat)
 
 
 def pitch_of(v):
