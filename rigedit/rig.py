@@ -1,14 +1,31 @@
 """A rig: mesh + skeleton + skin binding + clips, with the per-frame pipeline."""
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
+from .io.data import RigData, RigMeta, WeightsComputedWarning, register_rig_builder
 from .model.kinematics import local_to_model, skinning_matrices
 from .model.pose import Pose
 from .model.skinning import SkinBinding
 from .binding.weights import compute_weights, default_method
+from .io.save import save_rig
 
 __all__ = ["Rig"]
+
+
+class _InMeta:
+    """A rig attribute that reads and writes a field of ``rig.meta``."""
+
+    def __init__(self, field, doc):
+        self.field, self.__doc__ = field, doc
+
+    def __get__(self, rig, owner=None):
+        return self if rig is None else getattr(rig.meta, self.field)
+
+    def __set__(self, rig, value):
+        setattr(rig.meta, self.field, value)
 
 
 class Rig:
@@ -32,10 +49,13 @@ class Rig:
     surface : rigedit.surface.Surface, optional
         Normals, texture coordinates and materials where the source file had them (glTF);
         None otherwise. Rig folders do not store it yet.
+    meta : rigedit.io.data.RigMeta, optional
+        Where the rig came from and what its reader decided (units, rotation orders, clip
+        files, notes); kept as ``rig.meta``. A new, empty one when omitted.
     """
 
     def __init__(self, skeleton, vertices, faces, indices=None, weights=None, clips=None,
-                 name="rig", up="y", weights_method=None, path=None, surface=None):
+                 name="rig", up="y", weights_method=None, path=None, surface=None, meta=None):
         self.skeleton = skeleton
         self.vertices = np.asarray(vertices, dtype=np.float64)
         self.faces = np.asarray(faces, dtype=np.int64)
@@ -43,9 +63,7 @@ class Rig:
         self.name = name
         self.up = up
         self.path = path
-        #: What a reader decided where its format was silent, shown by ``rigedit info``:
-        #: ``{"units": ..., "frames": ...}``
-        self.notes = {}
+        self.meta = RigMeta(source=path) if meta is None else meta
         self.surface = surface
         self.weights_computed = indices is None
         self.weights_method = weights_method or default_method(self.faces)
@@ -53,6 +71,46 @@ class Rig:
             indices, weights = compute_weights(self.vertices, skeleton, self.weights_method,
                                                faces=self.faces)
         self.bind(indices, weights)
+
+    @classmethod
+    def from_data(cls, data, weights_method=None):
+        """The rig of a reader's :class:`~rigedit.io.data.RigData`.
+
+        Where the data has no skin influences (a rig folder without a weights file) the
+        weights are computed here, with ``weights_method`` (``heat`` by default for a mesh
+        with faces, ``idw`` for a point cloud, see :func:`rigedit.binding.weights.
+        default_method`), which can take seconds: a :class:`WeightsComputedWarning` says so
+        and ``rig.weights_computed`` is True.
+        """
+        indices, weights = data.indices, data.weights
+        method = weights_method or default_method(data.faces)
+        if indices is None:
+            what = "no weights file" if data.meta.format == "folder" else "no skin weights"
+            warnings.warn(f"{data.meta.source}: {what}; computed weights ({method})",
+                          WeightsComputedWarning, stacklevel=3)
+            indices, weights = compute_weights(data.vertices, data.skeleton, method,
+                                               faces=data.faces)
+        rig = cls(data.skeleton, data.vertices, data.faces, indices, weights, data.clips,
+                  name=data.name, up=data.up, weights_method=method, path=data.meta.source,
+                  surface=data.surface, meta=data.meta)
+        rig.weights_computed = data.indices is None
+        return rig
+
+    def data(self):
+        """The rig as a :class:`~rigedit.io.data.RigData` for the writers: the same arrays,
+        clips and ``meta`` (not copies), the influences as bound (``binding.indices``,
+        ``binding.weights``: (V, K), rows summing to 1)."""
+        return RigData(self.skeleton, self.vertices, self.faces, self.binding.indices,
+                       self.binding.weights, self.clips, surface=self.surface, name=self.name,
+                       up=self.up, meta=self.meta)
+
+    # the older spellings of three fields of ``meta`` (rig attributes before ``meta`` existed)
+    notes = _InMeta("notes", "What a reader decided where its format was silent "
+                    "(``meta.notes``), shown by ``rigedit info``: ``{\"units\": ..., ...}``.")
+    source_rotation_orders = _InMeta("rotation_orders", "Joint name -> rotation order of the "
+                                     "BVH file read (``meta.rotation_orders``).")
+    autorig_report = _InMeta("autorig_report", "What :func:`rigedit.autorig` decided "
+                             "(``meta.autorig_report``), None otherwise.")
 
     # ------------------------------------------------------------------ binding
     def bind(self, indices, weights):
@@ -133,10 +191,12 @@ class Rig:
     def save(self, path, clips=None):
         """Write the rig; the format follows ``path`` (a folder, .glb, .gltf or .bvh), see
         :func:`rigedit.io.save.save_rig`."""
-        from .io.save import save_rig
-
-        return save_rig(self, path, clips=clips)
+        return save_rig(self.data(), path, clips=clips)
 
     def __repr__(self):
         return (f"Rig({self.name!r}: {len(self.vertices)} vertices, {len(self.faces)} faces, "
                 f"{len(self.skeleton)} joints, {len(self.clips)} clips)")
+
+
+# the Rig-returning readers kept in io for compatibility build through this (rigedit/io/data.py)
+register_rig_builder(Rig.from_data)

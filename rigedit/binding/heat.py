@@ -36,7 +36,7 @@ from ..model.skinning import top_k_influences
 from ..model.helper_joints import helper_joints
 from .tails import branch_tails, deforming_joints, ik_chain_tails, infer_leaf_tails
 from .visibility import SurfaceRays
-from .weights import inverse_distance_weights, point_segment_distance
+from .distance import inverse_distance_weights, point_segment_distance
 
 try:  # CHOLMOD: measured faster than SuperLU (see benchmarks/bench_weights.py)
     from sksparse.cholmod import cholesky as _cholmod

@@ -44,7 +44,7 @@ def cmd_info(args):
             ("up", rig.up), ("bounds_min", " ".join(f"{v:.4g}" for v in lo)),
             ("bounds_max", " ".join(f"{v:.4g}" for v in hi)),
             ("clips", " ".join(sorted(rig.clips)) or "-")]
-    rows += sorted(getattr(rig, "notes", {}).items())  # what a reader decided: units, frames
+    rows += sorted(rig.meta.notes.items())  # what a reader decided: units, frames
     for key, value in rows:
         print(f"{key}: {value}")
     return 0

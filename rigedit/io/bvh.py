@@ -22,15 +22,15 @@ with a position channel. It does not loop. The rest pose is the OFFSETs with no 
 
 Carrier roots (:mod:`rigedit.model.carrier`: a root above the hips that only carries the
 figure, Bandai's ``joint_Root``, iClone's ``RL_BoneRoot``) are found on frames sampled over
-the clip; they deform nothing (``Skeleton.deform``), ``rig.notes["carrier"]`` names them,
+the clip; they deform nothing (``Skeleton.deform``), ``meta.notes["carrier"]`` names them,
 and the figure's size leaves them out.
 
 Units: BVH has none. ``scale`` (metres per file unit) converts; when it is omitted the unit
 is guessed from the figure's size (its largest extent over sampled frames, 90th percentile,
-carrier roots left out; see :func:`guess_unit`): the unit that makes it a human's
-1.2-2.2 m, else the nearest, NOT SURE. The guess is reported in a :class:`BvhUnitsWarning`
-and in ``rig.notes["units"]``. Frames: BVH is conventionally Y up, rigedit's own convention,
-so axes are kept as they are (``rig.notes["frames"]`` says so).
+carrier roots left out; see :func:`rigedit.io.bvh_units.guess_unit`): the unit that makes
+it a human's 1.2-2.2 m, else the nearest, NOT SURE. The guess is reported in a :class:`BvhUnitsWarning`
+and in ``meta.notes["units"]``. Frames: BVH is conventionally Y up, rigedit's own convention,
+so axes are kept as they are (``meta.notes["frames"]`` says so).
 """
 from __future__ import annotations
 
@@ -45,62 +45,19 @@ from ..errors import RigFileError
 from ..model.carrier import carrier_joints, carrier_note
 from ..model.skeleton import Skeleton
 from ..model.transforms import compose_trs, quat_multiply
-from ..rig import Rig
 from .bvh_parse import parse_bvh
+from .bvh_units import (HUMAN_SIZE, TYPICAL_HEIGHT, UNITS, BvhUnitsWarning, believable,
+                        guess_unit)
+from .bvh_write import save_bvh as _save_bvh
+from .data import RigData, RigMeta, build_rig
 
-__all__ = ["load_bvh", "save_bvh", "parse_bvh", "guess_unit", "believable",
-           "euler_channels_to_quats", "BvhUnitsWarning", "UNITS", "HUMAN_SIZE", "CLIP_NAME"]
+__all__ = ["read_bvh", "load_bvh", "save_bvh", "parse_bvh", "guess_unit", "believable",
+           "euler_channels_to_quats", "BvhUnitsWarning", "UNITS", "HUMAN_SIZE",
+           "TYPICAL_HEIGHT", "CLIP_NAME"]
 
 CLIP_NAME = "take"
-#: Units a BVH figure may be written in: name -> metres per unit. "CMU" is the unit of the
-#: Carnegie Mellon mocap library's BVH conversions (its ASF "length 0.45": 1/0.45 inch).
-UNITS = {"metres": 1.0, "centimetres": 0.01, "millimetres": 0.001, "inches": 0.0254,
-         "CMU units (1/0.45 inch)": 0.0254 / 0.45}
-#: The figure height a guess aims at (an adult human), metres.
-TYPICAL_HEIGHT = 1.7
-#: The sizes (largest extent, metres) a human figure may have: outside, a guess is flagged.
-HUMAN_SIZE = (1.2, 2.2)
 #: Frames looked at, evenly spaced, to find carrier roots and to measure the figure.
 SAMPLED_FRAMES = 32
-
-
-class BvhUnitsWarning(UserWarning):
-    """A BVH file's unit was guessed (no ``scale`` given)."""
-
-
-def guess_unit(size):
-    """The unit under which a figure ``size`` file units across is an adult's size.
-
-    Parameters
-    ----------
-    size : float
-        The figure's largest extent (height, or arm span in a T pose), carrier roots left
-        out.
-
-    Returns
-    -------
-    name : str
-    metres_per_unit : float
-
-    Notes
-    -----
-    The unit that makes the figure 1.2-2.2 m (:data:`HUMAN_SIZE`) when there is one (the
-    range is narrower than the ratio of any two units in :data:`UNITS`, so there is at most
-    one): a figure 120-220 units across reads as centimetres, 1.2-2.2 as metres, 1200-2200
-    as millimetres, 47-87 as inches, 21-39 as CMU units. Otherwise the unit whose figure is
-    nearest 1.7 m, which :func:`believable` then reports as not a human's size.
-    """
-    if not size > 0:
-        return "metres", 1.0
-    human = [u for u in UNITS if believable(size * UNITS[u])]
-    name = human[0] if len(human) == 1 else \
-        min(UNITS, key=lambda u: abs(np.log(size * UNITS[u] / TYPICAL_HEIGHT)))
-    return name, UNITS[name]
-
-
-def believable(metres):
-    """Whether a figure ``metres`` across is a human's size (:data:`HUMAN_SIZE`)."""
-    return HUMAN_SIZE[0] <= metres <= HUMAN_SIZE[1]
 
 
 def _axis_quats(axis, sin_half, cos_half):
@@ -203,8 +160,43 @@ def _figure_size(heads, tips, owners, carriers):
     return float(np.percentile(np.max(np.ptp(points, axis=1), axis=1), 90))
 
 
-def load_bvh(path, scale=None):
-    """Read a BVH file into a mesh-less :class:`Rig` with one clip (see the module notes).
+def _units(path, size, measured, scale):
+    """The scale (metres per unit) and what was decided: ``(scale, unit name or None,
+    guessed, note)``; the unit is guessed from the figure's ``size`` (file units) when
+    ``scale`` is None, and the guess is warned about."""
+    if scale is not None:
+        scale = float(scale)
+        if not np.isfinite(scale) or scale <= 0:
+            raise RigFileError(path, f"expected a scale > 0 (metres per unit), got {scale}")
+        return scale, None, False, (f"scale {scale:g} m per unit (given): "
+                                    f"{size * scale:.3g} m across")
+    unit, scale = guess_unit(size)
+    note = (f"guessed {unit} from the figure's size ({measured}): "
+            f"{size * scale:.3g} m, scale {scale:g} m per unit")
+    if not believable(size * scale):
+        note += (f"; NOT SURE: no unit makes it a human's {HUMAN_SIZE[0]:g}-"
+                 f"{HUMAN_SIZE[1]:g} m (not a human, or an unusual unit)")
+    warnings.warn(f"{path}: BVH has no units; {note}; pass --scale/scale= to override",
+                  BvhUnitsWarning, stacklevel=3)
+    return scale, unit, True, note
+
+
+def _clip(data, skeleton, rotations, translations, scale):
+    """``{"take": Clip}`` of the file's frames (one key per frame), {} without frames."""
+    if not len(data["frames"]):
+        return {}
+    names = data["names"]
+    times = np.arange(len(data["frames"])) * data["frame_time"]
+    tracks = {(names[j], "rotation"): Track("rotation", times, q, "slerp")
+              for j, q in rotations.items()}
+    tracks.update({(names[j], "translation"): Track("translation", times, t * scale, "linear")
+                   for j, t in translations.items()})
+    return {CLIP_NAME: Clip(CLIP_NAME, skeleton, tracks, duration=float(times[-1]), loop=False)}
+
+
+def read_bvh(path, scale=None):
+    """Read a BVH file into a mesh-less :class:`~rigedit.io.data.RigData` with one clip (see
+    the module notes).
 
     Parameters
     ----------
@@ -215,10 +207,12 @@ def load_bvh(path, scale=None):
 
     Returns
     -------
-    Rig
-        ``vertices`` (0, 3), ``faces`` (0, 3); ``clips`` ``{"take": Clip}`` unless the file
-        has no frames; ``notes`` with ``units`` and ``frames``, and ``carrier`` when the
-        skeleton has carrier roots (they are ``deform=False``).
+    RigData
+        ``vertices`` (0, 3), ``faces`` (0, 3), empty (0, 1) influences; ``clips``
+        ``{"take": Clip}`` unless the file has no frames; ``meta`` with ``scale``, ``units``
+        (the guessed unit, None when given), ``rotation_orders``, and ``notes`` with
+        ``units``, ``frames``, ``rotation_order`` and ``carrier`` when the skeleton has
+        carrier roots (they are ``deform=False``).
     """
     path = Path(path)
     data = parse_bvh(path)
@@ -231,20 +225,7 @@ def load_bvh(path, scale=None):
     left_out = ", ".join(names[j] for j in np.flatnonzero(carriers))
     measured = f"{size:.4g} units across" + (f", carrier root {left_out} left out"
                                              if left_out else "")
-    if scale is None:
-        unit, scale = guess_unit(size)
-        units_note = (f"guessed {unit} from the figure's size ({measured}): "
-                      f"{size * scale:.3g} m, scale {scale:g} m per unit")
-        if not believable(size * scale):
-            units_note += (f"; NOT SURE: no unit makes it a human's {HUMAN_SIZE[0]:g}-"
-                           f"{HUMAN_SIZE[1]:g} m (not a human, or an unusual unit)")
-        warnings.warn(f"{path}: BVH has no units; {units_note}; pass --scale/scale= to "
-                      f"override", BvhUnitsWarning, stacklevel=2)
-    else:
-        scale = float(scale)
-        if not np.isfinite(scale) or scale <= 0:
-            raise RigFileError(path, f"expected a scale > 0 (metres per unit), got {scale}")
-        units_note = f"scale {scale:g} m per unit (given): {size * scale:.3g} m across"
+    scale, unit, guessed, units_note = _units(path, size, measured, scale)
     rest = Skeleton(names, parents, offsets).bind_matrices[:, :3, 3]
     tails = np.full_like(rest, np.nan)
     for j, end in enumerate(ends):
@@ -253,34 +234,31 @@ def load_bvh(path, scale=None):
     # a carrier root deforms nothing: its "bone" runs from the floor (or the origin) to
     # the hips
     skeleton = Skeleton(names, parents, offsets * scale, tails=tails, deform=~carriers)
-    clips = {}
-    if len(data["frames"]):
-        times = np.arange(len(data["frames"])) * data["frame_time"]
-        tracks = {(names[j], "rotation"): Track("rotation", times, q, "slerp")
-                  for j, q in rotations.items()}
-        tracks.update({(names[j], "translation"): Track("translation", times, t * scale,
-                                                        "linear")
-                       for j, t in translations.items()})
-        clips[CLIP_NAME] = Clip(CLIP_NAME, skeleton, tracks, duration=float(times[-1]),
-                                loop=False)
-    rig = Rig(skeleton, np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64),
-              np.zeros((0, 1), dtype=np.int64), np.zeros((0, 1)), clips, name=path.stem,
-              up="y", path=path)
-    rig.notes = {"units": units_note,
-                 "frames": "BVH read as Y up, +Z forward (its usual convention), axes kept"}
-    if carriers.any():
-        rig.notes["carrier"] = carrier_note(names, parents, heads, carriers, scale)
     # each joint's rotation channel order, so that a BVH written back keeps it (bvh_write)
     orders = {name: "".join("XYZ"[axis] for kind, axis in channels if kind == "rotation")
               for name, channels in zip(names, data["channels"])}
-    rig.source_rotation_orders = {n: o for n, o in orders.items() if sorted(o) == list("XYZ")}
-    counts = Counter(rig.source_rotation_orders.values()).most_common()
-    rig.notes["rotation_order"] = ", ".join(f"{o} ({n} joints)" for o, n in counts) or "-"
-    return rig
+    orders = {n: o for n, o in orders.items() if sorted(o) == list("XYZ")}
+    notes = {"units": units_note,
+             "frames": "BVH read as Y up, +Z forward (its usual convention), axes kept"}
+    if carriers.any():
+        notes["carrier"] = carrier_note(names, parents, heads, carriers, scale)
+    counts = Counter(orders.values()).most_common()
+    notes["rotation_order"] = ", ".join(f"{o} ({n} joints)" for o, n in counts) or "-"
+    meta = RigMeta(source=path, format="bvh", units=unit, scale=scale, scale_guessed=guessed,
+                   rotation_orders=orders, notes=notes)
+    return RigData(skeleton, np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64),
+                   np.zeros((0, 1), dtype=np.int64), np.zeros((0, 1)),
+                   _clip(data, skeleton, rotations, translations, scale), name=path.stem,
+                   up="y", meta=meta)
+
+
+def load_bvh(path, scale=None):
+    """Read a BVH file into a mesh-less :class:`~rigedit.rig.Rig` with one clip
+    (:func:`read_bvh`, then ``Rig.from_data``); ``rig.meta`` and ``rig.notes`` say what was
+    decided."""
+    return build_rig(read_bvh(path, scale=scale))
 
 
 def save_bvh(rig, path, clip=None, **kwargs):
     """Write ``rig``'s skeleton and one clip as BVH; see :func:`rigedit.io.bvh_write.save_bvh`."""
-    from .bvh_write import save_bvh as _save_bvh
-
     return _save_bvh(rig, path, clip=clip, **kwargs)

@@ -28,9 +28,13 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import RigFileError
 from ..model.carrier import carrier_joints
+from ..model.kinematics import local_to_model
+from ..model.pose import Pose
 from .atomic import atomic_write
+from .bvh_units import HUMAN_SIZE, BvhUnitsWarning, believable
+from .data import as_rig_data
 
-__all__ = ["save_bvh", "bvh_frame_times", "DEFAULT_FPS"]
+__all__ = ["write_bvh", "save_bvh", "bvh_frame_times", "DEFAULT_FPS"]
 
 #: Frame rate used when a clip's keys are not on a regular grid.
 DEFAULT_FPS = 30.0
@@ -63,11 +67,11 @@ def bvh_frame_times(clip, fps=None):
     return np.arange(count) * dt, dt
 
 
-def _model_frames(rig, clip, times):
+def _model_frames(skeleton, clip, times):
     """(F, J, 4, 4) model matrices of the clip at ``times`` (the rest pose when no clip)."""
     if clip is None:
-        return rig.joint_matrices(rig.rest_pose())[None]
-    return np.stack([rig.joint_matrices(clip.sample(t)) for t in times])
+        return local_to_model(skeleton, Pose(skeleton))[None]
+    return np.stack([local_to_model(skeleton, clip.sample(t)) for t in times])
 
 
 def _local_parts(model, parents):
@@ -118,8 +122,6 @@ def _bvh_names(names):
 def _warn_unless_human(positions, parents, units_per_metre, path):
     """Warn when the figure in ``positions`` (F, J, 3) metres, carrier roots left out, is
     not a human's size: reading the file back will not guess its unit (BVH has none)."""
-    from .bvh import HUMAN_SIZE, BvhUnitsWarning, believable
-
     picks = positions[np.unique(np.linspace(0, len(positions) - 1, 32).round().astype(int))]
     carriers = carrier_joints(parents, picks)
     size = float(np.percentile(np.ptp(picks[:, ~carriers], axis=1).max(axis=1), 90))
@@ -135,7 +137,8 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order=None):
 
     Parameters
     ----------
-    rig : Rig
+    rig : RigData or Rig
+        The rig's data (:class:`~rigedit.io.data.RigData`; a Rig gives its ``data()``).
     path : str or os.PathLike
     clip : Clip or str, optional
         The clip to write; the rig's first clip when omitted, the rest pose (one frame)
@@ -147,13 +150,14 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order=None):
     order : str, optional
         Rotation channel order of every joint, three of ``XYZ`` (``ZXY`` writes ``Zrotation
         Xrotation Yrotation``); by default each joint keeps the order of the BVH file the rig
-        was read from (``rig.source_rotation_orders``), others get ``ZXY``.
+        was read from (``meta.rotation_orders``), others get ``ZXY``.
 
     Returns
     -------
     info : dict
         ``clip`` (name or None), ``frames``, ``frame_time``.
     """
+    rig = as_rig_data(rig)
     if isinstance(clip, str):
         if clip not in rig.clips:
             raise RigFileError(path, f"expected a clip of the rig, got {clip!r}")
@@ -161,16 +165,16 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order=None):
     if clip is None and rig.clips:
         clip = next(iter(rig.clips.values()))
     sk = rig.skeleton
-    source = getattr(rig, "source_rotation_orders", {}) if order is None else {}
+    source = rig.meta.rotation_orders if order is None else {}
     orders = [str(source.get(name, order or "ZXY")).upper() for name in sk.names]
     for o in set(orders):
         if sorted(o) != ["X", "Y", "Z"]:
             raise ValueError(f"expected a rotation order of X, Y and Z, got {o!r}")
     times, dt = bvh_frame_times(clip, fps)
-    local_rot, local_t, _, frame_pos = _local_parts(_model_frames(rig, clip, times),
+    local_rot, local_t, _, frame_pos = _local_parts(_model_frames(sk, clip, times),
                                                     sk.parents)
     _warn_unless_human(frame_pos, sk.parents, float(units_per_metre), path)
-    rest_model = rig.joint_matrices(rig.rest_pose())
+    rest_model = local_to_model(sk, Pose(sk))
     _, offsets, rest_rot, rest_pos = _local_parts(rest_model, sk.parents)
     size = float(np.ptp(np.vstack([rest_pos, local_t[:, 0]]), axis=0).max()) or 1.0
     moves = np.abs(local_t - offsets[None]).max(axis=(0, 2)) > 1e-9 * size
@@ -222,3 +226,11 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order=None):
         np.savetxt(fh, data, fmt="%.6f")
     return {"clip": None if clip is None else clip.name, "frames": len(times),
             "frame_time": dt}
+
+
+def write_bvh(data, path, clips=None):
+    """The registry's writer (:mod:`rigedit.io.registry`): :func:`save_bvh` of one clip, the
+    first named in ``clips`` or the rig's first; more than one is refused."""
+    if clips is not None and len(clips) > 1:
+        raise RigFileError(path, f"expected one clip for a BVH file, got {len(clips)}")
+    return save_bvh(data, path, clip=data.clips[clips[0]] if clips else None)

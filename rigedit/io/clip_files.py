@@ -5,7 +5,7 @@ A save deletes from ``animations/`` only clip files that are rigedit's:
 - those the folder's ``rig.json`` lists under ``"clips"`` (``{name: "animations/FILE.json"}``,
   written by every save), and
 - those the saved rig's clips were read from, when they are in this folder
-  (``load_rig_folder`` records them with :func:`remember_clip_files`).
+  (the rig-folder reader records them in ``meta.clip_files``, :func:`remember_clip_files`).
 
 A clip file rigedit has no record of that holds a clip of a name being saved becomes that
 clip's file (a document recovered after a crash, or saved over a folder it did not come from).
@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import json
 import stat
-import weakref
 from pathlib import Path, PurePosixPath
 
 from ..animation.clip_names import clip_file_stem, name_key
@@ -32,24 +31,20 @@ __all__ = ["ANIMATIONS", "plan_clip_files", "clip_entry", "remember_clip_files",
 
 ANIMATIONS = "animations"
 
-# Rig -> {clip name: resolved path} of the files its clips were loaded from. Kept beside the
-# rig rather than in it: only saving needs it, and a rig built in code has none.
-_LOADED_FROM = weakref.WeakKeyDictionary()
-
-
 def remember_clip_files(rig, files):
-    """Record that ``rig``'s clips were read from ``files`` (``{clip name: path}``).
+    """Record that ``rig``'s clips were read from ``files`` (``{clip name: path}``), in
+    ``rig.meta.clip_files`` (a Rig or a :class:`~rigedit.io.data.RigData`).
 
-    ``load_rig_folder`` calls it; code that rebuilds a rig from a copy of it (a recovery
+    The rig-folder reader records them; code that rebuilds a rig from a copy of it (a recovery
     snapshot) can pass on :func:`loaded_clip_files` of the original, so that a save over the
     original folder still deletes the files of clips deleted since."""
-    _LOADED_FROM[rig] = {name: Path(p).resolve() for name, p in files.items()}
+    rig.meta.clip_files = {name: Path(p).resolve() for name, p in files.items()}
 
 
 def loaded_clip_files(rig):
     """``{clip name: path}`` of the files ``rig``'s clips were read from (empty for a rig
     built in code)."""
-    return dict(_LOADED_FROM.get(rig, {}))
+    return dict(rig.meta.clip_files)
 
 
 def clip_entry(rel):
@@ -116,7 +111,7 @@ def plan_clip_files(folder, rig, names):
         file = clip_entry(rel)
         if file is not None:
             previous.setdefault(name, file)
-    for name, path in _LOADED_FROM.get(rig, {}).items():
+    for name, path in rig.meta.clip_files.items():
         if path.parent == anim:
             previous[name] = path.name
     present = sorted(p.name for p in anim.iterdir()) if anim.is_dir() else []

@@ -1,4 +1,4 @@
-"""glTF 2.0 in: a skinned glTF/GLB file -> :class:`~rigedit.rig.Rig`.
+"""glTF 2.0 in: a skinned glTF/GLB file -> :class:`~rigedit.io.data.RigData`.
 
 What is read
 ------------
@@ -30,12 +30,12 @@ import numpy as np
 from ..errors import RigFileError
 from ..model.skeleton import Skeleton, topological_order
 from ..model.transforms import compose_trs, decompose_trs
-from ..rig import Rig
+from .data import RigData, RigMeta, build_rig
 from .gltf_anim import read_clips
 from .gltf_data import GltfData
 from .gltf_mesh import read_mesh
 
-__all__ = ["load_gltf", "GltfWarning", "unique_names"]
+__all__ = ["read_gltf", "load_gltf", "GltfWarning", "unique_names"]
 
 
 class GltfWarning(UserWarning):
@@ -271,7 +271,7 @@ def _inverse_binds(data, skin_index, count):
     return m
 
 
-def load_gltf(path):
+def read_gltf(path):
     """Read a skinned glTF 2.0 file (``.gltf`` or ``.glb``).
 
     Parameters
@@ -280,9 +280,9 @@ def load_gltf(path):
 
     Returns
     -------
-    rig : Rig
-        With ``rig.surface`` (normals, UVs, materials and each vertex's primitive) and the
-        file's clips. A skin with no mesh bound gives a rig with 0 vertices.
+    RigData
+        With ``surface`` (normals, UVs, materials and each vertex's primitive), the file's
+        influences and clips. A skin with no mesh bound gives 0 vertices.
 
     Raises
     ------
@@ -293,7 +293,7 @@ def load_gltf(path):
     """
     data = GltfData(path)
     try:
-        return _load(data)
+        return _read(data)
     except RigFileError:
         raise
     except (TypeError, ValueError, KeyError, IndexError, AttributeError) as exc:
@@ -303,13 +303,20 @@ def load_gltf(path):
                                       f"({type(exc).__name__}: {exc})") from None
 
 
-def _load(data):
+def load_gltf(path):
+    """Read a skinned glTF 2.0 file into a :class:`~rigedit.rig.Rig` (:func:`read_gltf`, then
+    ``Rig.from_data``)."""
+    return build_rig(read_gltf(path))
+
+
+def _read(data):
     parent = _node_parents(data)
     skin_index, mesh_nodes = _choose_skin(data)
     skeleton, smap = _build_skeleton(data, skin_index, parent)
     mesh = read_mesh(data, mesh_nodes, len(data.gltf.skins[skin_index].joints), GltfWarning)
     indices = smap.skin_to_joint[mesh.joints] if mesh.joints.size else mesh.joints
     clips = read_clips(data, skeleton, smap, GltfWarning)
-    return Rig(skeleton, mesh.vertices, mesh.faces, indices, mesh.weights, clips,
-               name=data.path.stem, up="y", path=data.path, surface=mesh.surface)
+    return RigData(skeleton, mesh.vertices, mesh.faces, indices, mesh.weights, clips,
+                   surface=mesh.surface, name=data.path.stem, up="y",
+                   meta=RigMeta(source=data.path, format="gltf"))
 

@@ -1,5 +1,5 @@
-"""glTF 2.0 out: a :class:`~rigedit.rig.Rig` -> ``.glb`` (binary) or ``.gltf`` (one JSON file
-with its buffer embedded as a data URI).
+"""glTF 2.0 out: a rig's :class:`~rigedit.io.data.RigData` -> ``.glb`` (binary) or ``.gltf``
+(one JSON file with its buffer embedded as a data URI).
 
 What is written: the mesh (one primitive per primitive that came in, or one for a rig without
 surface data) with positions, normals (the file's, or area-weighted smooth normals), UVs and
@@ -29,6 +29,7 @@ import scipy.sparse as sp
 
 from ..errors import RigFileError
 from .atomic import atomic_write
+from .data import as_rig_data
 
 __all__ = ["save_gltf", "RESAMPLE_DEGREES"]
 
@@ -96,11 +97,10 @@ def _smooth_normals(vertices, faces):
 def _influences(rig):
     """(V, K) joint indices and float32-exact weights summing to 1, K = 4 or 8, no joint twice
     in a row, zero slots pointing at joint 0."""
-    b = rig.binding
-    v = b.num_vertices
-    k = b.indices.shape[1]
-    m = sp.csr_matrix((b.weights.ravel(), (np.repeat(np.arange(v), k), b.indices.ravel())),
-                      shape=(v, b.num_joints))
+    v = len(rig.vertices)
+    k = rig.indices.shape[1]
+    m = sp.csr_matrix((rig.weights.ravel(), (np.repeat(np.arange(v), k), rig.indices.ravel())),
+                      shape=(v, len(rig.skeleton)))
     m.sum_duplicates()
     m.eliminate_zeros()
     counts = np.diff(m.indptr)
@@ -284,7 +284,9 @@ def _animations(w, rig, joints, clips):
 
 
 def gltf_bytes(rig, binary=True, clips=None):
-    """The file's bytes: GLB when ``binary``, else glTF JSON with an embedded buffer."""
+    """The file's bytes: GLB when ``binary``, else glTF JSON with an embedded buffer; ``rig``
+    is a :class:`~rigedit.io.data.RigData` (a Rig gives its ``data()``)."""
+    rig = as_rig_data(rig)
     w = _Writer()
     mesh = _mesh(w, rig)
     joints, roots = _nodes(w, rig)
@@ -317,7 +319,8 @@ def save_gltf(rig, path, clips=None):
 
     Parameters
     ----------
-    rig : Rig
+    rig : RigData or Rig
+        The rig's data (:class:`~rigedit.io.data.RigData`; a Rig gives its ``data()``).
     path : str or Path
         ``.glb`` (binary) or ``.gltf`` (JSON with the buffer embedded as a data URI).
     clips : list[str], optional

@@ -1,9 +1,6 @@
 """Triangle meshes from OBJ (own fast reader), PLY, STL, VTK, VTU (meshio) and VTP."""
 from __future__ import annotations
 
-import contextlib
-import io
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -11,18 +8,14 @@ import numpy as np
 from ..errors import RigFileError
 from .atomic import atomic_write
 from .jsonfile import MAX_MAGNITUDE
+from .mesh_common import third_party_read, triangulate
 from .paths import read_bytes, regular_file
+from .vtp import read_vtp
 
 __all__ = ["MESH_SUFFIXES", "load_mesh", "save_obj", "weld_vertices", "triangulate",
            "third_party_read"]
 
 MESH_SUFFIXES = (".obj", ".ply", ".stl", ".vtk", ".vtu", ".vtp")
-
-
-def triangulate(polygons):
-    """Fan-triangulate a list of polygons (index lists) into (F, 3) int64."""
-    tris = [(p[0], p[i], p[i + 1]) for p in polygons for i in range(1, len(p) - 1)]
-    return np.array(tris, dtype=np.int64).reshape(-1, 3)
 
 
 def weld_vertices(vertices, faces, decimals=9):
@@ -96,24 +89,6 @@ def _read_obj(path):
     return vertices, faces
 
 
-def third_party_read(path, read):
-    """Call a third-party reader so that nothing it does reaches the user: its prints go to a
-    buffer, a ``sys.exit`` or any exception becomes a ``RigFileError`` naming the file."""
-    out = io.StringIO()
-    try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out), \
-                warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            return read()
-    except RigFileError:
-        raise
-    except (Exception, SystemExit) as exc:  # meshio calls sys.exit(1) on an unreadable file
-        said = " ".join(out.getvalue().split())
-        detail = str(exc) if not isinstance(exc, SystemExit) else ""
-        detail = " ".join((detail or said or type(exc).__name__).split())
-        raise RigFileError(path, f"cannot read mesh: {detail[:200]}") from None
-
-
 def _check_ply_header(path, size):
     """meshio's PLY reader loops for ever on a header without ``end_header`` and trusts the
     element counts: check both before it runs."""
@@ -179,8 +154,6 @@ def load_mesh(path, weld=True):
     if suffix == ".obj":
         vertices, faces = _read_obj(path)
     elif suffix == ".vtp":
-        from .vtp import read_vtp
-
         vertices, faces = read_vtp(path)
     elif suffix in MESH_SUFFIXES:
         vertices, faces = _read_meshio(path)

@@ -15,15 +15,13 @@ Layouts read::
 """
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import RigFileError
-from ..binding.weights import default_method
-from ..rig import Rig
 from .clip_json import load_clip
+from .data import RigData, RigMeta, WeightsComputedWarning, build_rig
 from .frames import change_axes, resolve_folder_frames
 from .jsonfile import choice, name, read_json, relative_path
 from .mesh import MESH_SUFFIXES, load_mesh
@@ -32,11 +30,8 @@ from .paths import list_folder, what_is
 from .skeleton_json import UP_AXES, load_skeleton
 from .weights_npz import load_weights, weights_vertex_count
 
-__all__ = ["load_rig_folder", "save_rig_folder", "find_rig_files", "WeightsComputedWarning"]
-
-
-class WeightsComputedWarning(UserWarning):
-    """A rig had no weights file, so weights were computed."""
+__all__ = ["read_rig_folder", "write_rig_folder", "load_rig_folder", "save_rig_folder",
+           "find_rig_files", "WeightsComputedWarning"]
 
 
 def _meshes_in(folder):
@@ -125,11 +120,13 @@ def find_rig_files(folder):
             "animations": animations, "manifest": manifest}
 
 
-def load_rig_folder(folder, weights_method=None):
-    """Load a rig folder (either layout) into a :class:`Rig`.
+def read_rig_folder(folder):
+    """Read a rig folder (either layout) into a :class:`~rigedit.io.data.RigData`.
 
-    Warns :class:`WeightsComputedWarning` when the weights were computed because the folder
-    has none, and ``UnknownJointsWarning`` for clips naming joints the skeleton lacks.
+    ``indices``/``weights`` are None when the folder has no weights file (the mesh is then
+    welded: the elk layout's OBJ exports split vertices at seams); ``meta.clip_files`` names
+    the file of every clip, ``meta.notes["frames"]`` an axis decision. Warns
+    ``UnknownJointsWarning`` for clips naming joints the skeleton lacks.
     """
     folder = Path(folder)
     if _is_dir(folder):
@@ -158,9 +155,6 @@ def load_rig_folder(folder, weights_method=None):
         indices, weights = np.zeros((0, 1), dtype=np.int64), np.zeros((0, 1))
     else:
         vertices, faces = read_mesh(weld=True)
-        method = weights_method or default_method(faces)
-        warnings.warn(f"{folder}: no weights file; computed weights ({method})",
-                      WeightsComputedWarning, stacklevel=2)
     # the elk layout's skeleton may be Z up over a Y-up mesh (rigedit/io/frames.py)
     skeleton, up, frames_note, clip_change = resolve_folder_frames(
         folder, skeleton, meta, vertices, files["manifest"])
@@ -173,13 +167,20 @@ def load_rig_folder(folder, weights_method=None):
         clips[clip.name], sources[clip.name] = clip, path
     if clip_change is not None:   # rigedit's formats: skeleton and clips change together
         skeleton, clips = change_axes(skeleton, clips, clip_change)
-    name = files["manifest"].get("name", folder.resolve().name)
-    rig = Rig(skeleton, vertices, faces, indices, weights, clips, name=name, up=up,
-              weights_method=weights_method, path=folder)
-    remember_clip_files(rig, sources)   # a later save replaces exactly these
+    data = RigData(skeleton, vertices, faces, indices, weights, clips,
+                   name=files["manifest"].get("name", folder.resolve().name), up=up,
+                   meta=RigMeta(source=folder, format="folder"))
+    remember_clip_files(data, sources)   # a later save replaces exactly these
     if frames_note:
-        rig.notes["frames"] = frames_note
-    return rig
+        data.meta.notes["frames"] = frames_note
+    return data
+
+
+def load_rig_folder(folder, weights_method=None):
+    """Load a rig folder into a :class:`~rigedit.rig.Rig` (:func:`read_rig_folder`, then
+    ``Rig.from_data``, which computes the weights of a folder without a weights file, warning
+    :class:`WeightsComputedWarning`)."""
+    return build_rig(read_rig_folder(folder), weights_method=weights_method)
 
 
 def save_rig_folder(folder, rig, mesh_name="mesh.obj", allow_bundled=False):
@@ -194,3 +195,12 @@ def save_rig_folder(folder, rig, mesh_name="mesh.obj", allow_bundled=False):
         Clip name -> file written, relative to ``folder``.
     """
     return save_rig_folder_atomic(folder, rig, mesh_name=mesh_name, allow_bundled=allow_bundled)
+
+
+def write_rig_folder(data, folder, clips=None):
+    """The registry's writer (:mod:`rigedit.io.registry`): :func:`save_rig_folder` of every
+    clip; a folder holds them all, so a selection is refused."""
+    if clips is not None:
+        raise RigFileError(folder, "expected no clip selection for a rig folder (it holds "
+                                   "every clip), got --clip")
+    return save_rig_folder(folder, data)

@@ -42,9 +42,11 @@ from pathlib import Path, PurePosixPath
 from ..animation.clip_names import check_clip_name
 from ..errors import RigFileError
 from .atomic import check_output_folder, fsync_folder, write_json
+from .bundled import is_bundled
 from .clip_files import (ANIMATIONS, clip_entry, loaded_clip_files, plan_clip_files,
                          remember_clip_files)
 from .clip_json import save_clip
+from .data import as_rig_data
 from .mesh import save_obj
 from .skeleton_json import save_skeleton
 from .weights_npz import save_weights
@@ -74,20 +76,6 @@ def folder_lock(folder, shared=False):
         os.close(fd)   # releases the lock
 
 
-def is_bundled(path):
-    """True when ``path`` is (inside) a bundled character or the installed package: those are
-    read-only for the editor (File > Save asks for a new place)."""
-    import rigedit
-
-    package = Path(rigedit.__file__).resolve().parent
-    roots = {Path(rigedit.ASSETS_DIR).resolve(), package, package.parent / "assets"}
-    try:
-        path = Path(path).resolve()
-    except (OSError, ValueError):   # a name the system refuses: no place of the package
-        return False
-    return any(path == root or root in path.parents for root in roots)
-
-
 # ---------------------------------------------------------------------- saving
 def save_rig_folder_atomic(folder, rig, mesh_name="mesh.obj", allow_bundled=False):
     """Write ``rig`` as a rig folder so that the folder matches it exactly, crash-safely.
@@ -96,7 +84,8 @@ def save_rig_folder_atomic(folder, rig, mesh_name="mesh.obj", allow_bundled=Fals
     ----------
     folder : str or Path
         Created when missing (its parent must exist).
-    rig : Rig
+    rig : RigData or Rig
+        The rig's data (:class:`~rigedit.io.data.RigData`; a Rig gives its ``data()``).
     mesh_name : str
         File name of the OBJ mesh.
     allow_bundled : bool
@@ -115,6 +104,7 @@ def save_rig_folder_atomic(folder, rig, mesh_name="mesh.obj", allow_bundled=Fals
         An invalid or doubled clip name (nothing is written).
     """
     folder = Path(folder)
+    rig = as_rig_data(rig)
     if not allow_bundled and is_bundled(folder):
         raise RigFileError(folder, "expected a folder of your own, got a bundled character "
                                    "(read-only): save it somewhere else")
@@ -142,7 +132,7 @@ def _save(folder, rig, names, mesh_name):
         if not meshless:
             save_obj(stage / mesh_name, rig.vertices, rig.faces,
                      header=f"rigedit rig {rig.name}")
-            save_weights(stage / "weights.npz", rig.binding.indices, rig.binding.weights,
+            save_weights(stage / "weights.npz", rig.indices, rig.weights,
                          rig.skeleton.names)
         save_skeleton(stage / "skeleton.json", rig.skeleton, up=rig.up)
         for clip in rig.clips.values():

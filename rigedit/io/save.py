@@ -1,4 +1,4 @@
-"""Save a rig in the format its path asks for.
+"""Save a rig in the format its path asks for (:mod:`rigedit.io.registry`).
 
 ==========================  =========================================================
 no suffix (a folder)        a rig folder (:func:`rigedit.io.rig_folder.save_rig_folder`)
@@ -11,7 +11,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import RigFileError
-from .load import format_function
+from .data import as_rig_data
+from .registry import format_of
 
 __all__ = ["save_rig"]
 
@@ -21,7 +22,8 @@ def save_rig(rig, path, clips=None):
 
     Parameters
     ----------
-    rig : Rig
+    rig : RigData or Rig
+        The rig's data (:class:`~rigedit.io.data.RigData`; a Rig gives its ``data()``).
     path : str or os.PathLike
         A folder (no suffix, or an existing directory), ``.glb``, ``.gltf`` or ``.bvh``.
     clips : list[str], optional
@@ -35,25 +37,9 @@ def save_rig(rig, path, clips=None):
         clip for a BVH file.
     """
     path = Path(path)
-    suffix = path.suffix.lower()
+    data = as_rig_data(rig)
     for name in clips or ():
-        if name not in rig.clips:
-            known = ", ".join(sorted(rig.clips)) or "none"
+        if name not in data.clips:
+            known = ", ".join(sorted(data.clips)) or "none"
             raise RigFileError(path, f"expected a clip of the rig ({known}), got {name!r}")
-    if suffix in (".glb", ".gltf"):
-        save_gltf = format_function("gltf_write", "save_gltf", path, "writer")
-        return save_gltf(rig, path, clips=clips)
-    if suffix == ".bvh":
-        if clips is not None and len(clips) > 1:
-            raise RigFileError(path, f"expected one clip for a BVH file, got {len(clips)}")
-        clip = rig.clips[clips[0]] if clips else None
-        return format_function("bvh", "save_bvh", path, "writer")(rig, path, clip=clip)
-    if suffix == "" or path.is_dir():
-        if clips is not None:
-            raise RigFileError(path, "expected no clip selection for a rig folder (it holds "
-                                     "every clip), got --clip")
-        from .rig_folder import save_rig_folder
-
-        return save_rig_folder(path, rig)
-    raise RigFileError(path, f"expected a folder or a .glb, .gltf or .bvh file to write, got "
-                             f"a {suffix} file")
+    return format_of(path, role="write").write(data, path, clips=clips)

@@ -14,7 +14,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from ..errors import RigFileError
-from .mesh import third_party_read, triangulate
+from .mesh_common import third_party_read, triangulate
 from .paths import read_bytes
 
 __all__ = ["read_vtp", "check_vtp"]

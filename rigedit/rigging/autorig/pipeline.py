@@ -428,14 +428,14 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     seconds["clips"] = time.perf_counter() - t0
     band("clips")(1.0)
     seconds["total"] = time.perf_counter() - t_all
-    rig.autorig_report = AutorigReport(source, t_name, orientation, place, checks, seconds,
-                                       emb.cost, list(emb.placed), clip_notes, t_pose,
-                                       list(emb.outside))
-    rig.autorig_report.embedded = np.array(emb.positions)
-    rig.autorig_report.sure = bool(confidence.sure)
-    rig.autorig_report.reasons = list(confidence.reasons)
-    rig.autorig_report.doubtful = list(confidence.doubtful)
-    rig.autorig_report.orientations = [t.describe() for t in tried]
-    rig.autorig_report.hints = _turned(hints, place)
-    rig.notes["autorig"] = (f"template {t_name}; orientation {orientation.describe()}")
+    report = AutorigReport(source, t_name, orientation, place, checks, seconds, emb.cost,
+                           list(emb.placed), clip_notes, t_pose, list(emb.outside))
+    rig.meta.autorig_report = report
+    report.embedded = np.array(emb.positions)
+    report.sure = bool(confidence.sure)
+    report.reasons = list(confidence.reasons)
+    report.doubtful = list(confidence.doubtful)
+    report.orientations = [t.describe() for t in tried]
+    report.hints = _turned(hints, place)
+    rig.meta.notes["autorig"] = (f"template {t_name}; orientation {orientation.describe()}")
     return rig
