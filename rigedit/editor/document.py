@@ -1,18 +1,16 @@
-"""The editor's single source of truth and its undo stack. Pure Python: no Qt, no VTK.
+"""The editor's single source of truth. Pure Python: no Qt, no VTK.
 
-Views subscribe with :meth:`Document.subscribe` and are told what changed; user input goes
-back through document methods. Every data change is a :class:`Command` on the
-:class:`UndoStack`, so it can be undone and redone exactly.
+The :class:`Document` holds an editing session (rig, pose, clips, time, selection, mode,
+undo stack), samples the current clip at the current time, and applies every edit, each data
+change as a :class:`Command` on the :class:`UndoStack`, so it can be undone and redone
+exactly. The edits that need more than a few lines (open and save, keys, clips, weights) are
+functions taking the document: :mod:`rigedit.editor.commands` lists them all.
 
-Events emitted (``callback(event, **info)``):
-
-``"rig"``        a new rig was loaded (everything changed)
-``"pose"``       the current pose changed (``joints``: indices or None for all)
-``"rest"``       the skeleton's rest pose or the skin binding changed
-``"selection"``  the selected joint changed (``joint``: index or None)
-``"time"``       the current time changed
-``"clip"``       the current clip or the clips changed
-``"undo"``       the undo stack changed (labels, can undo/redo)
+Every change is announced to the listeners as one of the typed events of
+:mod:`rigedit.editor.events` (:meth:`Document.listen`); listeners registered the old way
+(:meth:`Document.subscribe`) receive ``callback(name, **info)`` with the same names as
+before: ``"rig"``, ``"pose"`` (``joints``), ``"rest"``, ``"selection"`` (``joint``),
+``"time"`` (``time``), ``"clip"`` (``name``), ``"undo"``, and now ``"mode"`` (``mode``).
 """
 from __future__ import annotations
 
@@ -20,47 +18,20 @@ import numpy as np
 
 from ..model.skeleton import Skeleton
 from ..model.skinning import SkinBinding
+from . import events as ev
+from .auto_key import AutoKey
+from .mirror import mirror_map, mirror_name, mirror_pose, side_axis
 from .undo import Command, UndoStack
 
 __all__ = ["Command", "UndoStack", "Document", "mirror_name", "mirror_map", "mirror_pose",
-           "skeleton_with_moved_joint"]
+           "skeleton_with_moved_joint", "MODES"]
 
-
-_MIRROR_PAIRS = [("_L", "_R"), ("_l", "_r"), (".L", ".R"), (".l", ".r"), ("Left", "Right"),
-                 ("left", "right"), ("L_", "R_"), ("l_", "r_")]
-
-
-def mirror_name(name):
-    """The name of the other side's joint (``arm_L`` -> ``arm_R``, ``LeftHand`` ->
-    ``RightHand``), or None when the name has no side."""
-    for a, b in _MIRROR_PAIRS:
-        for x, y in ((a, b), (b, a)):
-            if x in ("L_", "R_", "l_", "r_"):
-                if name.startswith(x):
-                    return y + name[len(x):]
-            elif x in ("_L", "_R", "_l", "_r", ".L", ".R", ".l", ".r"):
-                if name.endswith(x):
-                    return name[:-len(x)] + y
-                if x + "_" in name or x + "." in name:  # thigh_L_01 style
-                    return name.replace(x + "_", y + "_", 1).replace(x + ".", y + ".", 1)
-            elif x in name:
-                return name.replace(x, y, 1)
-    return None
-
-
-def mirror_map(names):
-    """(J,) int: for each joint its mirror's index, or itself when it has none."""
-    index = {n: i for i, n in enumerate(names)}
-    out = np.arange(len(names))
-    for i, n in enumerate(names):
-        m = mirror_name(n)
-        if m is not None and m in index:
-            out[i] = index[m]
-    return out
+#: The editing modes: pose mode poses the character, edit (bind) mode moves rest positions.
+MODES = ("pose", "edit")
 
 
 class Document:
-    """The editor's state: rig, current pose, clips, time, selection, undo stack.
+    """The editor's state: rig, current pose, clips, time, selection, mode, undo stack.
 
     Parameters
     ----------
@@ -80,34 +51,50 @@ class Document:
         Seconds.
     undo_stack : UndoStack
     mode : {"pose", "edit"}
-        Pose mode poses the character; edit (bind) mode moves rest positions.
+        Pose mode poses the character; edit (bind) mode moves rest positions. Setting it
+        is :meth:`set_mode`.
+    auto_key : AutoKey
+        When ``auto_key.enabled``, pose edits write keys at the current time.
     modified : bool
         Whether the data differs from what was last saved or opened (undoing back to the
         saved state makes it false again).
     """
 
     def __init__(self, rig):
-        self._observers = []
+        self._listeners = ev.Listeners()
         self.undo_stack = UndoStack()
-        self.undo_stack.observers.append(lambda: self.emit("undo"))
-        self.mode = "pose"
+        self.undo_stack.observers.append(self._undo_changed)
+        self._mode = "pose"
         self._drag_before = None
         self._set_rig(rig)
         self._saved_top = None  # the undo stack's top command when last saved or opened
+        self.auto_key = AutoKey(self)   # watches the undo stack before the listeners hear
 
-    # ------------------------------------------------------------------ observers
+    # ------------------------------------------------------------------ listeners
+    def listen(self, callback):
+        """Call ``callback(event)`` with each :mod:`~rigedit.editor.events` event; returns
+        ``callback``."""
+        return self._listeners.listen(callback)
+
     def subscribe(self, callback):
-        """Call ``callback(event, **info)`` on every change; returns ``callback``."""
-        self._observers.append(callback)
-        return callback
+        """Call ``callback(name, **info)`` on every change (the string protocol kept for
+        views written before the typed events); returns ``callback``."""
+        return self._listeners.subscribe(callback)
 
     def unsubscribe(self, callback):
-        if callback in self._observers:
-            self._observers.remove(callback)
+        """Stop calling ``callback`` (registered with either method)."""
+        self._listeners.remove(callback)
 
     def emit(self, event, **info):
-        for cb in list(self._observers):
-            cb(event, **info)
+        """Tell every listener about ``event``: an :class:`~rigedit.editor.events.Event`, or
+        an old event name with its keywords (``emit("clip", name=...)``)."""
+        if isinstance(event, str):
+            event = ev.from_name(event, **info)
+        self._listeners.emit(event)
+
+    def _undo_changed(self):
+        s = self.undo_stack
+        self.emit(ev.UndoChanged(s.undo_label, s.redo_label, self.modified))
 
     # ------------------------------------------------------------------ rig
     def _set_rig(self, rig):
@@ -119,16 +106,18 @@ class Document:
         if len(rig.vertices) == 0 and self.current_clip is not None:
             # a skeleton without a mesh (BVH) has an arbitrary rest pose (Bandai's lies flat):
             # show its motion's first frame, where the timeline starts
-            rig.clips[self.current_clip].sample(0.0, out=self.pose)
+            self._sample_into_pose()
         self.mirror = mirror_map(rig.skeleton.names)
 
     def set_rig(self, rig, modified=False):
-        """Replace the rig (a file was opened): new pose, selection cleared, history cleared.
-        ``modified`` marks it unsaved (a recovered document)."""
+        """Replace the rig (a file was opened): selection cleared, history cleared, the
+        pose of the first clip at time 0 (the rest pose without clips). ``modified`` marks
+        it unsaved (a recovered document)."""
         self._set_rig(rig)
+        self._sample_into_pose()
         self.undo_stack.clear()
         self._saved_top = _NEVER_SAVED if modified else None
-        self.emit("rig")
+        self.emit(ev.RigReplaced())
 
     # ------------------------------------------------------------------ saved state
     @property
@@ -138,12 +127,12 @@ class Document:
     def mark_saved(self):
         """The current state is what is on disk (after a successful save)."""
         self._saved_top = self.undo_stack.top
-        self.emit("undo")
+        self._undo_changed()
 
     def mark_modified(self):
         """The current state is not on disk, whatever the history says (recovered work)."""
         self._saved_top = _NEVER_SAVED
-        self.emit("undo")
+        self._undo_changed()
 
     @property
     def skeleton(self):
@@ -153,23 +142,77 @@ class Document:
     def clips(self):
         return self.rig.clips
 
-    # ------------------------------------------------------------------ selection, time, clip
+    @property
+    def clip(self):
+        """The current :class:`~rigedit.animation.clip.Clip`, or None."""
+        return None if self.current_clip is None else self.rig.clips.get(self.current_clip)
+
+    # ------------------------------------------------------------------ mode, selection
+    @property
+    def mode(self):
+        return self._mode
+
+    @mode.setter
+    def mode(self, mode):
+        self.set_mode(mode)
+
+    def set_mode(self, mode):
+        """Switch to ``"pose"`` or ``"edit"`` mode (not an undo step)."""
+        if mode not in MODES:
+            raise ValueError(f"expected mode 'pose' or 'edit', got {mode!r}")
+        if mode != self._mode:
+            self._mode = mode
+            self.emit(ev.ModeChanged(mode))
+
     def select(self, joint):
         """Select a joint by index or name (None clears). Not an undo step."""
         j = None if joint is None else self.skeleton.joint_index(joint)
         if j != self.selection:
             self.selection = j
-            self.emit("selection", joint=j)
+            self.emit(ev.SelectionChanged(j))
 
-    def set_time(self, t):
+    # ------------------------------------------------------------------ time and clips
+    def sample(self, t=None):
+        """The current clip's pose at ``t`` seconds (default: the current time), a new
+        :class:`~rigedit.model.pose.Pose`; None without a clip."""
+        clip = self.clip
+        if clip is None:
+            return None
+        return clip.sample(self.time if t is None else float(t), out=self.rig.rest_pose())
+
+    def _sample_into_pose(self):
+        """Write the current clip's pose at the current time into :attr:`pose`, without an
+        event; False when there is nothing to sample or a drag holds the pose."""
+        clip = self.clip
+        if clip is None or self.dragging:
+            return False
+        clip.sample(self.time, out=self.pose)
+        return True
+
+    def set_time(self, t, sample=True):
+        """Go to ``t`` seconds; the pose becomes the current clip's there (unless ``sample``
+        is false or a drag holds the pose). Not an undo step, as playback and scrubbing."""
         self.time = float(t)
-        self.emit("time", time=self.time)
+        sampled = sample and self._sample_into_pose()
+        self.emit(ev.TimeChanged(self.time))
+        if sampled:
+            self.emit(ev.PoseChanged())
 
     def set_current_clip(self, name):
+        """Edit clip ``name`` (None: none); the pose becomes its pose at the current time."""
         if name is not None and name not in self.rig.clips:
             raise KeyError(f"unknown clip {name!r}")
         self.current_clip = name
-        self.emit("clip", name=name)
+        self.clip_changed(ev.ClipChanged(name))
+
+    def clip_changed(self, event, resample=True):
+        """Announce a change of the clips (``event``: ClipChanged or KeysChanged), the pose
+        sampled from the current clip again first unless ``resample`` is false (a key just
+        written from the pose). Clip commands call it from their do and undo."""
+        sampled = resample and self._sample_into_pose()
+        self.emit(event)
+        if sampled:
+            self.emit(ev.PoseChanged())
 
     # ------------------------------------------------------------------ pose
     def set_pose(self, pose, joints=None):
@@ -180,7 +223,7 @@ class Document:
             raise ValueError(f"expected a pose of {len(self.skeleton)} joints, got shape "
                              f"{arr.shape}")
         self.pose.set_array(arr)
-        self.emit("pose", joints=joints)
+        self.emit(ev.PoseChanged(None if joints is None else tuple(int(j) for j in joints)))
 
     def pose_snapshot(self):
         """(J, 10) copy of the current pose (see :meth:`Pose.as_array`)."""
@@ -206,6 +249,14 @@ class Document:
     @property
     def dragging(self):
         return self._drag_before is not None
+
+    def drag_euler(self, joint, angles, degrees=True):
+        """One step of an interactive rotation (a slider held): the pose shows it at once;
+        :meth:`end_drag` makes the whole of it one undo step."""
+        j = self.skeleton.joint_index(joint)
+        self.begin_drag()
+        self.pose.set_euler(j, angles, degrees=degrees)
+        self.emit(ev.PoseChanged((j,)))
 
     def end_drag(self, label):
         """Close an interactive edit: the whole of it becomes one undo step."""
@@ -246,17 +297,7 @@ class Document:
         left-right plane. ``source`` "L" copies left onto right, "R" the reverse."""
         self.edit_pose(f"Mirror pose {source}->{'R' if source == 'L' else 'L'}",
                        lambda p: mirror_pose(p, self.mirror, self.skeleton.names,
-                                             self._side_axis(), source))
-
-    def _side_axis(self):
-        """Index of the model axis that runs left-right: the one along which the rest
-        positions of mirrored joint pairs differ most."""
-        heads = self.skeleton.bind_matrices[:, :3, 3]
-        pairs = np.flatnonzero(self.mirror != np.arange(len(self.mirror)))
-        if len(pairs) == 0:
-            return 0
-        diff = np.abs(heads[pairs] - heads[self.mirror[pairs]]).sum(axis=0)
-        return int(np.argmax(diff))
+                                             side_axis(self.skeleton, self.mirror), source))
 
     # ------------------------------------------------------------------ rest pose and binding
     def rest_state(self):
@@ -270,15 +311,18 @@ class Document:
         return (skeleton, binding, self.pose_snapshot() if pose is None else np.array(pose))
 
     def apply_rest_state(self, state):
+        """Put a :meth:`rest_state` in place; announces WeightsChanged when only the
+        binding differs, else RestChanged, then PoseChanged."""
         skeleton, binding, pose = state
         if len(skeleton) != len(self.skeleton) or binding.num_vertices != len(self.rig.vertices):
             raise ValueError("expected a rest state of this rig's joints and vertices")
+        same_skeleton, same_binding = skeleton is self.rig.skeleton, binding is self.rig.binding
         self.rig.skeleton = skeleton
         self.pose.skeleton = skeleton
         self.rig.binding = binding
         self.pose.set_array(pose)
-        self.emit("rest")
-        self.emit("pose", joints=None)
+        self.emit(ev.WeightsChanged() if same_skeleton else ev.RestChanged(not same_binding))
+        self.emit(ev.PoseChanged())
 
     def push_rest_edit(self, label, before, after, execute=True):
         """Record a rest/binding change (states from :meth:`rest_state` or
@@ -305,43 +349,6 @@ class Document:
 
 #: A saved-state marker that no command matches: the document is unsaved.
 _NEVER_SAVED = object()
-
-
-def mirror_pose(pose, mirror, names, axis, source="L"):
-    """Copy one side's local transforms onto the other, reflected across the plane normal to
-    model ``axis`` (in place).
-
-    Reflecting across the plane normal to x maps a rotation quaternion (x, y, z, w) to
-    (x, -y, -z, w) (the component along the normal keeps its sign, the others flip) and a
-    translation's x to -x. This is exact when the two sides' parent frames are mirror images
-    aligned with the model axes: the usual case, and always so for frames built from head
-    positions (elk skeletons, the bundled characters).
-    """
-    flip = np.ones(3)
-    flip[axis] = -1.0
-    qflip = -flip  # quaternion vector part under a reflection: -(sign) of each axis
-    for i, name in enumerate(names):
-        j = mirror[i]
-        if j == i or _side_of(name) != source:
-            continue
-        pose.translation[j] = pose.translation[i] * flip
-        q = pose.rotation[i].copy()
-        q[:3] *= qflip
-        pose.rotation[j] = q
-        pose.scale[j] = pose.scale[i]
-
-
-def _side_of(name):
-    """"L", "R" or None from a joint name."""
-    m = mirror_name(name)
-    if m is None:
-        return None
-    for left, right in _MIRROR_PAIRS:
-        if (left in name and right in m) and not (right in name and left in m):
-            return "L"
-        if right in name and left in m:
-            return "R"
-    return None
 
 
 def skeleton_with_moved_joint(skeleton, joint, head):

@@ -1,9 +1,11 @@
-"""Joint drags of the editor's 3D view: pose-mode IK drags, axis-constrained drags (the
-toolbar's axis or an arrow handle), and edit-mode rest moves (re-bound on release by
+"""Joint drags: pose-mode IK drags, axis-constrained drags (the toolbar's axis or an arrow
+handle), and edit-mode rest moves (re-bound on release by
 :class:`~rigedit.ui.rebind.RestRebind`).
 
-The :class:`DragController` is built for each scene (a rig opened builds a new one) with what
-it uses; it never reaches into the window.
+:class:`PoseDrag` is the editing command alone (a joint pulled towards points, one undo step
+at the end), usable from a script; the :class:`DragController` drives it from the 3D view's
+gizmos. The controller is built for each scene (a rig opened builds a new one) with what it
+uses; it never reaches into the window.
 """
 from __future__ import annotations
 
@@ -13,7 +15,7 @@ import numpy as np
 
 from ..model.ik import drag_joint
 
-__all__ = ["DragController", "DragSettings"]
+__all__ = ["DragController", "DragSettings", "PoseDrag", "constrain"]
 
 
 @dataclass
@@ -39,6 +41,47 @@ def constrain(start, center, axis):
         return center
     e = np.eye(3)[axis]
     return start + np.dot(center - start, e) * e
+
+
+class PoseDrag:
+    """A pose-mode drag of one joint as document edits: each :meth:`step` solves IK from the
+    pose at the press (:func:`~rigedit.model.ik.drag_joint`: a root moves, another joint turns
+    its chain) and shows the result; :meth:`end` makes the whole drag one undo step.
+
+    Parameters
+    ----------
+    document : Document
+        Its joint ``joint`` is selected and its pose remembered (``begin_drag``).
+    joint : int or str
+    chain_length : int
+        IK chain length (1: turn the parent only).
+    """
+
+    def __init__(self, document, joint, chain_length=2):
+        self.document = document
+        self.joint = document.skeleton.joint_index(joint)
+        self.chain_length = int(chain_length)
+        document.select(self.joint)
+        self.start = document.pose_snapshot()
+        self.work = document.pose.copy()
+        document.begin_drag()
+
+    def step(self, target):
+        """Pull the joint towards ``target`` (3,) model space; the document shows the pose
+        (PoseChanged), not yet an undo step."""
+        d = self.document
+        self.work.set_array(self.start)
+        drag_joint(d.skeleton, self.work, self.joint, target, self.chain_length,
+                   fk=d.rig.joint_matrices)
+        d.set_pose(self.work)
+
+    def end(self, label=None):
+        """Release: the drag becomes one undo step (none when the pose did not change)."""
+        self.document.end_drag(label or f"Drag {self.document.skeleton.names[self.joint]}")
+
+    def cancel(self):
+        """Give up the drag: the pose at the press comes back."""
+        self.document.cancel_drag()
 
 
 class DragController:
@@ -72,8 +115,8 @@ class DragController:
     ----------
     drag : dict or None
         The drag under way: ``joint``, ``start`` (3,), ``axis``, ``pose`` (the snapshot at
-        the press), ``target`` (3,) once moved, ``heads`` (J, 3) the rest heads shown by an
-        edit-mode drag.
+        the press), ``ik`` (the :class:`PoseDrag` of a pose-mode drag), ``target`` (3,) once
+        moved, ``heads`` (J, 3) the rest heads shown by an edit-mode drag.
     """
 
     def __init__(self, document, scene, gizmos, axes, settings, move_rest, status,
@@ -101,9 +144,9 @@ class DragController:
         d.select(j)
         self.drag = {"joint": j, "start": self.gizmos.center(j),
                      "axis": self.settings.axis if axis is None else axis,
-                     "pose": d.pose_snapshot(), "work": d.pose.copy()}
+                     "pose": d.pose_snapshot()}
         if d.mode == "pose":
-            d.begin_drag()
+            self.drag["ik"] = PoseDrag(d, j, self.settings.chain_length)
 
     def move(self, j, center):
         """The dragged sphere is at ``center`` (3,)."""
@@ -114,7 +157,7 @@ class DragController:
         if drag["axis"] is not None:
             self.gizmos.set_center(j, target)
         drag["target"] = target
-        if self.document.mode == "pose":
+        if "ik" in drag:
             self.step(j, target)
         else:
             heads = drag.get("heads")
@@ -128,14 +171,11 @@ class DragController:
             self.axes.set_position(target)
 
     def step(self, j, target):
-        """One pose-mode drag step: IK from the pose at drag start, then the document's pose
-        set (its event updates the view's points in place; no render)."""
-        work = self.drag["work"]
-        work.set_array(self.drag["pose"])
-        d = self.document
-        drag_joint(d.skeleton, work, j, target, self.settings.chain_length,
-                   fk=d.rig.joint_matrices)
-        d.set_pose(work)
+        """One pose-mode drag step (:meth:`PoseDrag.step`; its event updates the view's
+        points in place; no render). The tool bar's chain length is read at each step."""
+        ik = self.drag["ik"]
+        ik.chain_length = self.settings.chain_length
+        ik.step(target)
 
     def end(self, j):
         """The drag of joint ``j`` ends: one undo step (pose mode) or a rest move."""
@@ -144,8 +184,8 @@ class DragController:
             return
         d = self.document
         name = d.skeleton.names[j]
-        if d.mode == "pose":
-            d.end_drag(f"Drag {name}")
+        if "ik" in drag:
+            drag["ik"].end(f"Drag {name}")
             # Snap the sphere onto where the joint really is (it may not reach the mouse).
             self.gizmos.set_center(j, self.scene.joint_positions[j])
             self.status(f"Posed {name}")

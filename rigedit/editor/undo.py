@@ -50,6 +50,9 @@ class UndoStack:
         #: Counts every change of the history (push, amend, undo, redo, clear), so a reader
         #: such as the autosave can tell "changed since I last looked" with one integer.
         self.revision = 0
+        #: What the last change of the history was: "push", "amend", "undo", "redo" or
+        #: "clear" (None before any). The auto-key keys after a push, never after an undo.
+        self.last_action = None
 
     def push(self, command, execute=True):
         """Record ``command``; run its ``do`` first unless ``execute`` is false (for edits
@@ -59,7 +62,7 @@ class UndoStack:
         self._done.append(command)
         del self._done[:-self.limit]
         self._undone.clear()
-        self._notify()
+        self._notify("push")
 
     def amend(self, command, label=None, execute=True):
         """Run ``command`` and fold it into the last step, so one undo reverts both (an
@@ -81,7 +84,7 @@ class UndoStack:
 
         self._done.append(Command(label or f"{last.label} + {command.label}", do, undo))
         self._undone.clear()
-        self._notify()
+        self._notify("amend")
 
     def undo(self):
         """Revert the last command; returns it, or None when there is nothing to undo."""
@@ -90,7 +93,7 @@ class UndoStack:
         cmd = self._done.pop()
         cmd.undo()
         self._undone.append(cmd)
-        self._notify()
+        self._notify("undo")
         return cmd
 
     def redo(self):
@@ -100,13 +103,13 @@ class UndoStack:
         cmd = self._undone.pop()
         cmd.do()
         self._done.append(cmd)
-        self._notify()
+        self._notify("redo")
         return cmd
 
     def clear(self):
         self._done.clear()
         self._undone.clear()
-        self._notify()
+        self._notify("clear")
 
     @property
     def top(self):
@@ -132,7 +135,8 @@ class UndoStack:
     def __len__(self):
         return len(self._done)
 
-    def _notify(self):
+    def _notify(self, action):
         self.revision += 1
+        self.last_action = action
         for cb in list(self.observers):
             cb()

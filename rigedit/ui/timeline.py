@@ -1,13 +1,13 @@
 """The timeline dock: its widgets, playback, and the document's events.
 
 Data flow (docs/architecture.md): the ruler paints and reports mouse gestures; the dock turns them
-into document calls. Time goes through ``Document.set_time``; on the document's ``"time"``
-event the dock samples the current clip and shows the pose with ``Document.set_pose`` (no
-undo step), so scrubbing, playback and scripts all take the same path and the 3D view and
-gizmos follow. Key edits (:class:`~rigedit.editor.timeline_keys.KeyEditor`, the dock's
-:attr:`~TimelineDock.keys`) and clip edits (:class:`~rigedit.ui.timeline_clips.ClipManager`,
-:attr:`~TimelineDock.clip_manager`) are :class:`~rigedit.editor.document.Command` objects on the
-document's undo stack, one per user action (:mod:`rigedit.editor.timeline_edits`).
+into document calls. Time goes through ``Document.set_time``, which samples the current clip
+and shows its pose (no undo step), so scrubbing, playback and scripts all take the same path
+and the 3D view and gizmos follow. Key edits (:class:`~rigedit.editor.timeline_keys.KeyEditor`,
+the dock's :attr:`~TimelineDock.keys`) and clip edits
+(:class:`~rigedit.ui.timeline_clips.ClipManager`, :attr:`~TimelineDock.clip_manager`) are the
+editor's commands (:mod:`rigedit.editor.key_commands`, :mod:`rigedit.editor.clip_commands`), one
+undo step per user action; the dock follows the document's typed events.
 
 Playback is driven by elapsed time (:class:`~rigedit.animation.playback.PlaybackClock` fed
 with ``time.perf_counter``) from a QTimer: a slow frame skips ahead.
@@ -20,9 +20,9 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 
 from ..animation.interpolate import ROTATION_MODES, VECTOR_MODES
 from ..animation.playback import PlaybackClock
-from .timeline_clips import ClipManager
-from ..editor.timeline_edits import ClipEdits
+from ..editor import events as ev
 from ..editor.timeline_keys import KeyEditor
+from .timeline_clips import ClipManager
 from .timeline_ruler import TimelineRuler
 
 __all__ = ["TimelineDock", "TimelineRuler"]
@@ -63,21 +63,17 @@ class TimelineDock(QtWidgets.QDockWidget):
         self.document = window.document
         self.clock = PlaybackClock()
         self.fps = 30.0
-        self._pose = None
-        self._resample = True
-        self.edits = ClipEdits(self.document, self._clip_changed)
-        self.clip_manager = ClipManager(self.document, self.edits, self, self.pause,
-                                        self.set_time, self._error)
-        self.keys = KeyEditor(self.document, self.edits, lambda: self.fps, self.set_time,
-                              self.pause, self._show_key_drag, self.clip_manager.new_clip,
-                              self._error)
+        self.clip_manager = ClipManager(self.document, self, self.pause, self.set_time,
+                                        self._error)
+        self.keys = KeyEditor(self.document, lambda: self.fps, self.set_time, self.pause,
+                              self._show_key_drag, self._error)
         self.timer = QtCore.QTimer(self)
         self.timer.setTimerType(QtCore.Qt.PreciseTimer)
         self.timer.timeout.connect(self._tick)
         self._build()
         self._shortcuts(window)
         window.installEventFilter(self)
-        self.document.subscribe(self._on_document)
+        self.document.listen(self._on_event)
         self._reload_clips()
 
     # ================================================================== widgets
@@ -191,7 +187,7 @@ class TimelineDock(QtWidgets.QDockWidget):
     @property
     def clip(self):
         """The current :class:`~rigedit.animation.clip.Clip`, or None."""
-        return self.edits.clip
+        return self.document.clip
 
     @property
     def time(self):
@@ -203,7 +199,9 @@ class TimelineDock(QtWidgets.QDockWidget):
         return self.clock.playing
 
     def _duration(self):
-        return self.edits.duration()
+        """The current clip's duration in seconds (1 without a clip or for an empty one)."""
+        clip = self.clip
+        return clip.duration if clip is not None and clip.duration > 0 else 1.0
 
     # ================================================================== time and playback
     def set_time(self, t):
@@ -262,44 +260,18 @@ class TimelineDock(QtWidgets.QDockWidget):
         if not self.clock.playing:
             self.pause()
 
-    def _show_clip_pose(self):
-        clip = self.clip
-        if clip is None or self.document.dragging:
-            return
-        if self._pose is None or self._pose.skeleton is not self.document.skeleton:
-            self._pose = self.document.rig.rest_pose()
-        clip.sample(self.time, out=self._pose)
-        self.document.set_pose(self._pose)
-
-    def _sample_new_rig(self):
-        """A new rig shows its clip's pose at the current time. Written into the document's
-        pose without a "pose" event: listeners after this one (the window) still hold the old
-        rig until the same "rig" event reaches them, and they then show the document's pose
-        (a "pose" event now would skin the old mesh with the new rig's joints)."""
-        clip = self.clip
-        if clip is not None and not self.document.dragging:
-            clip.sample(self.time, out=self.document.pose)
-
     # ================================================================== document events
-    def _on_document(self, event, **info):
-        if event == "time":
-            self._show_clip_pose()
+    def _on_event(self, event):
+        if isinstance(event, ev.TimeChanged):
             self._refresh_ruler()
-        elif event in ("clip", "rig"):
-            if event == "rig":
-                self.pause()
-                self._pose = None
+        elif isinstance(event, ev.RigReplaced):
+            self.pause()
             self._reload_clips()
-            if self._resample and event == "rig":
-                self._sample_new_rig()
-            elif self._resample:
-                self._show_clip_pose()
-            self._resample = True
-        elif event == "selection":
+        elif isinstance(event, ev.ClipChanged):   # KeysChanged too
+            self._reload_clips()
+        elif isinstance(event, ev.SelectionChanged):
             self._refresh_ruler()
             self._show_modes()
-        elif event == "undo":
-            self.keys.maybe_auto_key()
 
     def _reload_clips(self):
         d = self.document
@@ -320,7 +292,7 @@ class TimelineDock(QtWidgets.QDockWidget):
         self._refresh_ruler()
 
     def _show_modes(self):
-        clip, name = self.clip, self.edits.joint_name()
+        clip, name = self.clip, self.keys.joint_name()
         if clip is None:
             return
         for combo, channels in ((self.rot_combo, ("rotation",)),
@@ -333,7 +305,7 @@ class TimelineDock(QtWidgets.QDockWidget):
             combo.blockSignals(False)
 
     def _refresh_ruler(self):
-        clip, name = self.clip, self.edits.joint_name()
+        clip, name = self.clip, self.keys.joint_name()
         summary = clip.key_times() if clip is not None else []
         joint = clip.key_times(name) if clip is not None and name is not None else []
         self.ruler.set_data(self._duration(), self.fps, self.time, summary, joint, name)
@@ -349,17 +321,10 @@ class TimelineDock(QtWidgets.QDockWidget):
         label.setText(_time_text(self.time, self.fps))
 
     # ================================================================== edits
-    def _clip_changed(self, resample):
-        """An edit was done or undone: tell the document (``resample`` False keeps the pose
-        instead of sampling the clip again)."""
-        self._resample = resample
-        self.document.emit("clip", name=self.document.current_clip)
-
     def _show_key_drag(self, t):
-        """Show the clip at ``t`` while a key mark is dragged there."""
-        self._resample = True
+        """Show the clip at ``t`` while a key mark is dragged there (the ruler follows the
+        document's TimeChanged)."""
         self.document.set_time(t)
-        self._refresh_ruler()
 
     def set_auto_key(self, on):
         """Posing writes keys at the current time (:attr:`KeyEditor.auto_key`)."""
