@@ -131,14 +131,15 @@ def _read_gltf(path):
     from dataclasses import replace
 
     from ...io.gltf_data import GltfData
-    from ...io.gltf_read import load_gltf
+    from ...io.gltf_read import read_gltf
+    from ...rig import Rig
 
     data = GltfData(path)
     nodes = data.gltf.nodes or []
     meshed = [i for i, n in enumerate(nodes) if n.mesh is not None]
     skins = {nodes[i].skin for i in meshed}
     if meshed and len(skins) == 1 and None not in skins:
-        rig = load_gltf(path)
+        rig = Rig.from_data(read_gltf(path))
         vertices = rig.skin(rig.rest_pose()) if len(rig.vertices) else rig.vertices
         surface = replace(rig.surface, normals=None) if rig.surface is not None else None
         return np.asarray(vertices, dtype=np.float64), rig.faces, surface

@@ -41,7 +41,8 @@ def load_template(template):
     elif isinstance(template, Skeleton):
         rig, skeleton, name = None, template, "skeleton"
     else:
-        from ... import BUNDLED, load_rig
+        from ...io.bundled import BUNDLED
+        from ...io.load import read_rig
         from ...io.mesh import MESH_SUFFIXES
 
         path = Path(template)
@@ -60,7 +61,7 @@ def load_template(template):
                 skeleton, _ = change_axes(skeleton, {}, axis_change(meta["up"], "y"))
             rig = None
         elif str(template) in BUNDLED or path.exists() or suffix in (".glb", ".gltf", ".bvh"):
-            rig = load_rig(template)
+            rig = Rig.from_data(read_rig(template))
             skeleton = rig.skeleton
         else:
             raise RigFileError(path, "expected a template: humanoid, quadruped, a skeleton "
