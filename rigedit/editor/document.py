@@ -297,7 +297,10 @@ class Document:
         left-right plane. ``source`` "L" copies left onto right, "R" the reverse."""
         self.edit_pose(f"Mirror pose {source}->{'R' if source == 'L' else 'L'}",
                        lambda p: mirror_pose(p, self.mirror, self.skeleton.names,
-                                             side_axis(self.skeleton, self.mirror), source))
+                                             self._side_axis(), source))
+
+    def _side_axis(self):
+        return side_axis(self.skeleton, self.mirror)   # the model axis running left-right
 
     # ------------------------------------------------------------------ rest pose and binding
     def rest_state(self):
