@@ -10,7 +10,6 @@ from .model.kinematics import local_to_model, skinning_matrices
 from .model.pose import Pose
 from .model.skinning import SkinBinding
 from .binding.weights import compute_weights, default_method
-from .io.save import save_rig
 
 __all__ = ["Rig"]
 
@@ -191,6 +190,10 @@ class Rig:
     def save(self, path, clips=None):
         """Write the rig; the format follows ``path`` (a folder, .glb, .gltf or .bvh), see
         :func:`rigedit.io.save.save_rig`."""
+        # imported here, not at the top: the registry loads every format's modules (glTF's
+        # pygltflib among them), about 0.1 s that ``import rigedit`` need not pay
+        from .io.save import save_rig
+
         return save_rig(self.data(), path, clips=clips)
 
     def __repr__(self):

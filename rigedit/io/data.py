@@ -27,7 +27,9 @@ class RigMeta:
     Attributes
     ----------
     source : Path or None
-        The file or folder read; None for a rig built in code.
+        The file or folder read; None for a rig built in code. (``rig.path``, where the
+        editor's Save goes, starts as this and may change: a recovered document's path is
+        its original folder, its source the snapshot.)
     format : str or None
         The registry name of the format read (``"folder"``, ``"gltf"``, ``"bvh"``).
     units : str or None
