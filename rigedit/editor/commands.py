@@ -25,13 +25,13 @@ from .clip_commands import (add_clip, delete_clip, duplicate_clip, new_clip, ren
 from .deform import set_joint_deform
 from .drag import PoseDrag
 from .files import export_rig, open_document, open_rig, save_rig_folder
-from .key_commands import (copy_keys, delete_key, key_near, move_keys, paste_keys,
+from .key_commands import (KeyDrag, copy_keys, delete_key, key_near, move_keys, paste_keys,
                            set_interpolation, set_key)
 from .recompute import RecomputeWeights, recompute_weights
 from .weight_stroke import WeightStroke
 
 __all__ = ["open_document", "open_rig", "save_rig_folder", "export_rig", "PoseDrag",
-           "set_key", "key_near", "delete_key", "move_keys", "copy_keys", "paste_keys",
+           "set_key", "key_near", "delete_key", "move_keys", "KeyDrag", "copy_keys", "paste_keys",
            "set_interpolation", "new_clip", "add_clip", "rename_clip", "duplicate_clip",
            "delete_clip", "set_duration", "unique_clip_name", "WeightStroke",
            "set_joint_deform", "RecomputeWeights", "recompute_weights"]

@@ -11,8 +11,8 @@ import numpy as np
 
 from .clip_edits import edit_clip
 
-__all__ = ["set_key", "key_near", "delete_key", "move_keys", "copy_keys", "paste_keys",
-           "set_interpolation", "changed_joints", "DEFAULT_TOLERANCE"]
+__all__ = ["set_key", "key_near", "delete_key", "move_keys", "KeyDrag", "copy_keys",
+           "paste_keys", "set_interpolation", "changed_joints", "DEFAULT_TOLERANCE"]
 
 #: How near (seconds) a key must be to a time to be "at" it: half a frame at 30 fps.
 DEFAULT_TOLERANCE = 0.5 / 30
@@ -84,6 +84,49 @@ def move_keys(document, moves, joints=None):
              "Move key {:.2f}s -> {:.2f}s".format(*next(iter(moves.items()))))
     names = _names(document, joints)
     return edit_clip(document, label, lambda c: c.move_keys(moves, names))
+
+
+class KeyDrag:
+    """A key dragged along the time line (the ruler's key marks): the clip shows the key where
+    it is dragged at once, and :meth:`end` makes the whole move one undo step.
+
+    Parameters
+    ----------
+    document : Document
+        Its current clip; the document's time follows the key as it moves.
+    t : float
+        The time of the key grabbed.
+    joints : list or None
+        Whose keys move (None: every joint's at ``t``).
+    """
+
+    def __init__(self, document, t, joints=None):
+        self.document = document
+        self.clip = document.clip
+        self.before = None if self.clip is None else self.clip.state()
+        self.old = self.new = float(t)
+        self.joints = _names(document, joints)
+
+    def move(self, t):
+        """The key is at ``t`` seconds now: the clip and the pose show it there (no undo
+        step yet)."""
+        t = float(t)
+        if self.clip is None or t == self.new:
+            return
+        self.clip.restore(self.before)
+        self.clip.move_keys({self.old: t}, self.joints)
+        self.new = t
+        self.document.set_time(t)
+
+    def end(self):
+        """Release: one undo step for the whole move (none when the key is back where it
+        was, or the clip is no longer the current one). Returns the tracks changed."""
+        if self.clip is None or self.new == self.old:
+            return 0
+        self.clip.restore(self.before)
+        if self.clip is not self.document.clip:
+            return 0
+        return move_keys(self.document, {self.old: self.new}, self.joints)
 
 
 def copy_keys(document, joints=None, t=None):

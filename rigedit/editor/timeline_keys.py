@@ -2,8 +2,8 @@
 joint (all joints when none is selected, or when asked) at the current time, the copy buffer,
 key-mark drags, and the auto-key switch.
 
-Every edit is one undo step. A key-mark drag moves the key live (the clip shows it where it
-is dragged) and becomes one undo step at the release.
+Every edit is one undo step. A key-mark drag (:class:`~.key_commands.KeyDrag`) moves the key
+live (the clip shows it where it is dragged) and becomes one undo step at the release.
 """
 from __future__ import annotations
 
@@ -24,8 +24,6 @@ class KeyEditor:
         Moves the timeline to ``t`` seconds (a key drag starts there).
     pause : callable()
         Stops playback (a key drag pauses it).
-    show_time : callable(t)
-        Shows the clip at ``t`` while a key is dragged (the key already moved).
     error : callable(message)
         Shows why an edit was refused.
 
@@ -37,12 +35,11 @@ class KeyEditor:
         What :meth:`copy_keys` copied (``Clip.copy_keys``).
     """
 
-    def __init__(self, document, fps, seek, pause, show_time, error):
+    def __init__(self, document, fps, seek, pause, error):
         self.document = document
         self.fps = fps
         self.seek = seek
         self.pause = pause
-        self.show_time = show_time
         self.error = error
         self.clipboard = None
         self._drag = None
@@ -105,34 +102,20 @@ class KeyEditor:
     # ------------------------------------------------------------------ key drags
     def key_drag_start(self, t, all_joints):
         """The ruler started dragging the key mark at ``t`` (of every joint, or the
-        selected one's)."""
+        selected one's): playback pauses and the timeline goes there."""
         self.pause()
-        clip = self.document.clip
-        if clip is None:
+        if self.document.clip is None:
             return
-        joints = None if all_joints else self.scope(False)
-        self._drag = {"clip": clip, "before": clip.state(), "old": t, "new": t,
-                      "joints": joints}
         self.seek(t)
+        self._drag = keys.KeyDrag(self.document, t, None if all_joints else self.scope(False))
 
     def key_drag_move(self, t):
         """The dragged key is at ``t``: the clip shows it there (not yet an undo step)."""
-        drag = self._drag
-        if drag is None or t == drag["new"]:
-            return
-        clip = drag["clip"]
-        clip.restore(drag["before"])
-        clip.move_keys({drag["old"]: t}, drag["joints"])
-        drag["new"] = t
-        self.show_time(t)
+        if self._drag is not None:
+            self._drag.move(t)
 
     def key_drag_end(self):
         """The drag ended: the whole move becomes one undo step."""
         drag, self._drag = self._drag, None
-        if drag is None or drag["new"] == drag["old"]:
-            return
-        clip = drag["clip"]
-        clip.restore(drag["before"])
-        if clip is not self.document.clip:
-            return   # the clip was replaced meanwhile: nothing of it to move
-        keys.move_keys(self.document, {drag["old"]: drag["new"]}, drag["joints"])
+        if drag is not None:
+            drag.end()

@@ -66,7 +66,7 @@ class TimelineDock(QtWidgets.QDockWidget):
         self.clip_manager = ClipManager(self.document, self, self.pause, self.set_time,
                                         self._error)
         self.keys = KeyEditor(self.document, lambda: self.fps, self.set_time, self.pause,
-                              self._show_key_drag, self._error)
+                              self._error)
         self.timer = QtCore.QTimer(self)
         self.timer.setTimerType(QtCore.Qt.PreciseTimer)
         self.timer.timeout.connect(self._tick)
@@ -321,11 +321,6 @@ class TimelineDock(QtWidgets.QDockWidget):
         label.setText(_time_text(self.time, self.fps))
 
     # ================================================================== edits
-    def _show_key_drag(self, t):
-        """Show the clip at ``t`` while a key mark is dragged there (the ruler follows the
-        document's TimeChanged)."""
-        self.document.set_time(t)
-
     def set_auto_key(self, on):
         """Posing writes keys at the current time (:attr:`KeyEditor.auto_key`)."""
         self.keys.auto_key = bool(on)

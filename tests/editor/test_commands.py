@@ -148,3 +148,32 @@ def test_open_replaces_the_rig_and_samples_its_first_clip(tmp_path):
         cmd.save_rig_folder(doc)    # the bundled character's own folder is read-only
     cmd.open_rig(doc, tmp_path / "cyl")
     assert len(doc.rig.vertices) == len(cylinder_rig().vertices) and doc.current_clip is None
+
+
+def test_a_key_dragged_shows_where_it_is_and_is_one_undo_step(doc):
+    drag = cmd.KeyDrag(doc, 0.5, ["j1"])
+    drag.move(0.6)
+    drag.move(0.8)
+    np.testing.assert_allclose(doc.clip.key_times("j1"), [0, 0.8, 1])
+    assert doc.time == 0.8 and len(doc.undo_stack) == 0   # shown, not yet a step
+    np.testing.assert_allclose(doc.pose.get_euler("j1", degrees=True), [0, 0, 60], atol=1e-6)
+    assert drag.end() == 1
+    assert doc.undo_stack.undo_label == "Move key 0.50s -> 0.80s" and len(doc.undo_stack) == 1
+    doc.undo()
+    np.testing.assert_allclose(doc.clip.key_times("j1"), [0, 0.5, 1])
+    back = cmd.KeyDrag(doc, 0.5)
+    back.move(0.7)
+    back.move(0.5)
+    assert back.end() == 0 and doc.undo_stack.can_redo   # no step pushed (it clears redo)
+
+
+def test_a_cancelled_recompute_changes_nothing(doc):
+    from rigedit.progress import Cancelled
+
+    def cancel(fraction, stage):
+        raise Cancelled()
+
+    b0 = doc.rig.binding
+    with pytest.raises(Cancelled):
+        cmd.recompute_weights(doc, "heat", progress=cancel)
+    assert doc.rig.binding is b0 and len(doc.undo_stack) == 0
