@@ -82,8 +82,19 @@ class TimelineDock(QtWidgets.QDockWidget):
         lay = QtWidgets.QVBoxLayout(body)
         lay.setContentsMargins(4, 2, 4, 2)
         lay.setSpacing(2)
-        row1, row2 = QtWidgets.QHBoxLayout(), QtWidgets.QHBoxLayout()
-        keys, clips = self.keys, self.clip_manager
+        self.ruler = TimelineRuler()
+        self.ruler.scrubbed.connect(self._scrub)
+        self.ruler.key_drag_started.connect(self.keys.key_drag_start)
+        self.ruler.key_dragged.connect(self.keys.key_drag_move)
+        self.ruler.key_drag_finished.connect(self.keys.key_drag_end)
+        lay.addLayout(self._playback_row())
+        lay.addLayout(self._keys_row())
+        lay.addWidget(self.ruler, 1)
+        self.setWidget(body)
+
+    def _playback_row(self):
+        """Play, loop, speed, frame rate, the clip and its duration, the time."""
+        row1, clips = QtWidgets.QHBoxLayout(), self.clip_manager
         self.stop_button = _button("■ Stop", "Stop and go to the start", self.stop)
         self.play_button = _button("▶ Play", "Play / pause", self.toggle_play)
         self.loop_box = QtWidgets.QCheckBox("Loop")
@@ -127,6 +138,11 @@ class TimelineDock(QtWidgets.QDockWidget):
             row1.addWidget(w)
         row1.addStretch(1)
         row1.addWidget(self.time_label)
+        return row1
+
+    def _keys_row(self):
+        """Key, delete, copy and paste keys, auto-key, interpolation."""
+        row2, keys = QtWidgets.QHBoxLayout(), self.keys
         self.auto_box = QtWidgets.QCheckBox("Auto-key")
         self.auto_box.setToolTip("Posing writes keys at the current time")
         self.auto_box.toggled.connect(self.set_auto_key)
@@ -155,15 +171,7 @@ class TimelineDock(QtWidgets.QDockWidget):
                   QtWidgets.QLabel("Translation/scale"), self.vec_combo):
             row2.addWidget(w)
         row2.addStretch(1)
-        self.ruler = TimelineRuler()
-        self.ruler.scrubbed.connect(self._scrub)
-        self.ruler.key_drag_started.connect(keys.key_drag_start)
-        self.ruler.key_dragged.connect(keys.key_drag_move)
-        self.ruler.key_drag_finished.connect(keys.key_drag_end)
-        lay.addLayout(row1)
-        lay.addLayout(row2)
-        lay.addWidget(self.ruler, 1)
-        self.setWidget(body)
+        return row2
 
     def _shortcuts(self, window):
         keys = self.keys
