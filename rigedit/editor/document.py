@@ -63,7 +63,7 @@ class Document:
     def __init__(self, rig):
         self._listeners = ev.Listeners()
         self.undo_stack = UndoStack()
-        self.undo_stack.observers.append(self._undo_changed)
+        self.undo_stack.observers.append(lambda: self.emit("undo"))
         self._mode = "pose"
         self._drag_before = None
         self._set_rig(rig)
@@ -88,13 +88,12 @@ class Document:
     def emit(self, event, **info):
         """Tell every listener about ``event``: an :class:`~rigedit.editor.events.Event`, or
         an old event name with its keywords (``emit("clip", name=...)``)."""
-        if isinstance(event, str):
+        if event == "undo":   # filled in here: the old name carries nothing
+            s = self.undo_stack
+            event = ev.UndoChanged(s.undo_label, s.redo_label, self.modified)
+        elif isinstance(event, str):
             event = ev.from_name(event, **info)
         self._listeners.emit(event)
-
-    def _undo_changed(self):
-        s = self.undo_stack
-        self.emit(ev.UndoChanged(s.undo_label, s.redo_label, self.modified))
 
     # ------------------------------------------------------------------ rig
     def _set_rig(self, rig):
@@ -127,12 +126,12 @@ class Document:
     def mark_saved(self):
         """The current state is what is on disk (after a successful save)."""
         self._saved_top = self.undo_stack.top
-        self._undo_changed()
+        self.emit("undo")
 
     def mark_modified(self):
         """The current state is not on disk, whatever the history says (recovered work)."""
         self._saved_top = _NEVER_SAVED
-        self._undo_changed()
+        self.emit("undo")
 
     @property
     def skeleton(self):

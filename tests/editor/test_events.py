@@ -58,3 +58,12 @@ def test_rest_edits_say_whether_the_skeleton_or_only_the_weights_changed():
     assert not set_joint_deform(doc, "j2", False)   # already so: no step
     doc.undo()
     assert doc.skeleton.deform[2]
+
+
+def test_undo_emitted_by_name_carries_the_history_state():
+    doc = Document(cylinder_rig())
+    doc.set_joint_euler(1, [0, 0, 10])
+    heard = []
+    doc.listen(heard.append)
+    doc.emit("undo")
+    assert heard == [ev.UndoChanged("Rotate j1", "", True)]
