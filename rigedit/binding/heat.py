@@ -34,6 +34,7 @@ import scipy.sparse as sp
 from . import laplacian as lap
 from ..model.skinning import top_k_influences
 from ..model.helper_joints import helper_joints
+from ..progress import adapt
 from .tails import branch_tails, deforming_joints, ik_chain_tails, infer_leaf_tails
 from .visibility import SurfaceRays
 from .distance import inverse_distance_weights, point_segment_distance
@@ -194,8 +195,10 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
     faces : (F, 3) int
         Required: heat flows over the surface.
     max_influences : int
-    progress : callable(fraction), optional
-        Called between stages; an exception it raises (a cancel) stops the computation.
+    progress : callable(fraction, stage), optional
+        :mod:`rigedit.progress`'s protocol (stage ``"heat"``), called between the steps;
+        :class:`rigedit.progress.Cancelled` (or any exception) raised by it stops the
+        computation. The older ``progress(fraction)`` still works (deprecated).
     c : float
         Heat constant of ``H = c / d^2``.
     min_weight : float
@@ -241,7 +244,7 @@ def heat_weights(vertices, skeleton, faces=None, max_influences=4, progress=None
     ValueError
         NaN or infinite coordinates, no faces, face indices out of range.
     """
-    report = progress or (lambda f: None)
+    report = adapt(progress, "heat")   # report(fraction): the stage is always "heat"
     timings = {}
     t0 = time.perf_counter()
     vertices, faces = _check_input(vertices, faces)

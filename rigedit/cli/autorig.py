@@ -26,11 +26,12 @@ def run_autorig(args):
         bar = tqdm(total=100, unit="%", desc="autorig", bar_format="{desc}: {percentage:3.0f}% "
                                                                    "{bar} {postfix}")
 
-    def progress(fraction, stage):
+    def progress(fraction, stage):   # rigedit.progress's protocol
         check_interrupted()
         if bar is not None:
-            bar.set_postfix_str(stage)
-            bar.update(round(100 * fraction) - bar.n)
+            bar.set_postfix_str(stage or "")
+            if fraction is not None:   # None: a step that cannot tell; the bar waits
+                bar.update(round(100 * fraction) - bar.n)
 
     with warning_lines():  # heat's fallbacks, bones outside the mesh: a line each
         try:

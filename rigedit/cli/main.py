@@ -117,7 +117,7 @@ def check_options(args):
 
 def cmd_render(args):
     from .output import check_interrupted, deferred
-    from ..render.recorder import record_clip
+    from ..render.recorder import frame_times, record_clip
 
     size = _parse_size(args.size)  # fps, duration and size were checked by check_options
     rig = _load(args.rig, scale=args.scale)
@@ -129,14 +129,13 @@ def cmd_render(args):
     if sys.stderr.isatty() and not args.quiet:
         from tqdm import tqdm
 
-        bar = tqdm(total=None, unit="frame", desc=f"render {args.clip}")
+        bar = tqdm(total=len(frame_times(args.duration or clip.duration or 1.0, args.fps)),
+                   unit="frame", desc=f"render {args.clip}")
 
-    def progress(done, total):
+    def progress(fraction, stage):   # rigedit.progress's protocol
         check_interrupted()
-        if bar is not None:
-            bar.total = total
-            bar.update(done - bar.n)
-        return True
+        if bar is not None and fraction is not None:
+            bar.update(round(fraction * bar.total) - bar.n)
 
     t0 = time.perf_counter()
     try:

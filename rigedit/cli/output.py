@@ -34,7 +34,10 @@ _deferring = [False]
 
 class Interrupted(BaseException):
     """The run got SIGINT or SIGTERM. A ``BaseException``, like ``KeyboardInterrupt``, so that
-    ``except Exception`` in the middle of a job does not swallow it."""
+    ``except Exception`` in the middle of a job does not swallow it, and for that reason not
+    a :class:`rigedit.progress.Cancelled` (an ``Exception``): the command's progress
+    callables raise it at a job's step boundary (:func:`check_interrupted`) where a window's
+    would raise ``Cancelled``, and the job lets it through the same way."""
 
     def __init__(self, signum):
         self.signum = signum

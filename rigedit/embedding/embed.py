@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..binding.laplacian import face_areas
+from ..progress import adapt, scaled
 from .distance import distance_field
 from .fit import W_SCALE_FIRM, W_SCALE_WEAK, fit_joints
 from .graph import medial_graph
@@ -134,8 +135,11 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None,
     faces : (F, 3) int
     template : rigedit.Skeleton
         Its rest pose gives the template's joint positions.
-    progress : callable(fraction), optional
-        Called with the fraction done (0..1); may raise to cancel (the exception propagates).
+    progress : callable(fraction, stage), optional
+        :mod:`rigedit.progress`'s protocol: called with the fraction done (0..1) and the
+        stage ``"embed"``; raising :class:`rigedit.progress.Cancelled` (or anything) cancels
+        (the exception propagates). The older ``progress(fraction)`` still works
+        (deprecated).
     template_mesh : ((V, 3) float64, (F, 3) int), optional
         The template's own mesh at its rest pose (a bundled character's, a .glb's). With it
         the scale comes from the two heights and the template's ground is known; without it
@@ -159,7 +163,7 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None,
         outside the mesh.
     """
     seconds = {}
-    report = progress or (lambda fraction: None)
+    report = adapt(progress, "embed")
 
     def stage(name, fraction, fn, *args, **kw):
         t0 = time.perf_counter()
@@ -198,7 +202,7 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None,
             f"{len(graph.points)} medial spheres, expected at least {len(reduced.joints)} "
             "(is it a blob without limbs?)")
     t0 = time.perf_counter()
-    sub = (lambda f: report(0.55 + 0.25 * f)) if progress else None
+    sub = scaled(report, 0.55, 0.8) if progress is not None else None
     found = discrete_embedding(graph, reduced, frame, scale, sub, field_, pins)
     seconds["search"] = time.perf_counter() - t0
     report(0.8)

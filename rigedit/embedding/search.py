@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..progress import adapt
 from .fit import FEET
 from .hints import hint_pair, hint_unary
 from .penalties import (SEPARATE_RATIO, W_CARRY, W_LENGTH, W_LENGTH_TAIL, bone_costs,
@@ -101,8 +102,10 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None,
         distance field's cell size).
     scale : float
         Mesh units per template unit.
-    progress : callable(fraction), optional
-        Called now and then with the fraction done (may raise to cancel).
+    progress : callable(fraction, stage), optional
+        :mod:`rigedit.progress`'s protocol (stage ``"search"``), called now and then with
+        the fraction done; may raise to cancel. The older ``progress(fraction)`` still
+        works (deprecated).
     field : DistanceField, optional
         The mesh's distance field: two feet must then stand apart, the straight segment
         between them leaving the mesh (a gap between the legs), which no blob has.
@@ -116,6 +119,7 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None,
     Search
         ``vertex`` is None when nothing fits; ``failed`` then names the reduced joint.
     """
+    progress = None if progress is None else adapt(progress)
     pts, dist = graph.points, graph.dist
     r = len(template.joints)
     n = len(pts)
@@ -245,7 +249,7 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None,
             return _done(state, expansions)
         expansions += 1
         if expansions % 200 == 0 and progress is not None:
-            progress(min(1.0, expansions / MAX_EXPANSIONS))
+            progress(min(1.0, expansions / MAX_EXPANSIONS), "search")
         if expansions > MAX_EXPANSIONS:
             break
         for child in expand(state):

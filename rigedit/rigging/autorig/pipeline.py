@@ -36,6 +36,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ...errors import RigFileError
+from ...progress import adapt, scaled
 from .mesh_check import check_mesh, read_mesh
 from .confidence import check_embedding, fit_score
 from .orient import SURE_FORWARD, Orientation, check_axes, hypotheses
@@ -287,7 +288,9 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     clips : bool
         Give the template's clips to the new character.
     progress : callable(fraction, stage), optional
-        Called as the work advances; an exception it raises cancels.
+        :mod:`rigedit.progress`'s protocol, called as the work advances (stages
+        ``STAGES``); :class:`rigedit.progress.Cancelled` (or any exception) raised by it
+        cancels.
     hints : dict[str, (3,) float], optional
         Template joint name -> where it must be, in the mesh's (the input's) coordinates:
         those joints are pinned and the embedding places the others around them.
@@ -309,13 +312,13 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
     from ...binding.weights import compute_weights
     from ...rig import Rig
 
-    report = progress or (lambda fraction, stage: None)
+    tell = adapt(progress)
     seconds = {}
     t_all = time.perf_counter()
 
     def band(stage):
         lo, hi = STAGES[stage]
-        return lambda f: report(lo + (hi - lo) * float(f), stage)
+        return scaled(tell, lo, hi, stage)
 
     t0 = time.perf_counter()
     band("load/check")(0.0)
@@ -355,7 +358,7 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
         for t_sk, t_pose in poses:   # the first standing pose of the template that fits
             try:
                 emb = embed_skeleton(emb_v, remap[body_f], t_sk, template_mesh=t_mesh,
-                                     progress=lambda f: sub(f / trials),
+                                     progress=lambda f, stage=None: sub(f / trials),
                                      hints=_turned(hints, place))
                 return emb, place, t_sk, t_pose
             except HintError as exc:   # an unknown joint, a point outside the mesh
@@ -421,7 +424,9 @@ def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", cl
         for i, clip_name in enumerate(names):
             band("clips")(i / len(names))
             try:
-                rig.clips[clip_name] = retarget(t_rig, t_rig.clips[clip_name], rig)
+                step = scaled(band("clips"), i / len(names), (i + 1) / len(names))
+                rig.clips[clip_name] = retarget(t_rig, t_rig.clips[clip_name], rig,
+                                                progress=step)
                 clip_notes[clip_name] = "retargeted"
             except ValueError as exc:  # a clip the retargeting cannot carry: say why
                 clip_notes[clip_name] = f"left out: {exc}"

@@ -37,6 +37,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ...animation.clip import Clip
+from ...progress import adapt
 from .bake import assemble, to_clip
 from .bare import bare_result
 from .calibrate import calibrate, model_stack
@@ -122,7 +123,8 @@ def _facing(src, tgt, smats):
     return deg, Rotation.from_euler("y", deg, degrees=True).as_matrix()
 
 
-def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_feet=True):
+def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_feet=True,
+             progress=None):
     """Retarget ``source_clip`` of ``source_rig`` onto ``target_rig`` (two humanoids, or
     any two skeletons with legs on the floor whose joints share names or are mapped).
 
@@ -139,6 +141,10 @@ def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_fee
         The new clip's name (the source clip's by default).
     clean_feet : bool
         Hold feet still during the source's contacts and keep them above the floor.
+    progress : callable(fraction, stage), optional
+        :mod:`rigedit.progress`'s protocol, called between the steps (stages
+        ``"calibrate"``, ``"map"``, ``"transfer"``, ``"feet"``, ``"clip"``); raising
+        :class:`rigedit.progress.Cancelled` there stops the retarget.
 
     Returns
     -------
@@ -151,13 +157,21 @@ def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_fee
         Naming the file: when either skeleton has no legs on the floor, when the map names
         unknown joints, is empty or leaves the target's hips (a humanoid's legs) unmapped.
     """
-    return retarget_result(source_rig, source_clip, target_rig, map, name, clean_feet).clip
+    return retarget_result(source_rig, source_clip, target_rig, map, name, clean_feet,
+                           progress=progress).clip
 
 
 def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
-                    clean_feet=True, source_what="source", target_what="target"):
+                    clean_feet=True, source_what="source", target_what="target",
+                    progress=None):
     """As :func:`retarget`, returning a :class:`RetargetResult` (the map, calibrations,
-    contacts and the model matrices before and after the foot clean-up)."""
+    contacts and the model matrices before and after the foot clean-up).
+
+    Over 80 lines: the retarget's steps in their order, each a call, kept in one place
+    so that the order (calibrate, map, facing, contacts, transfer, feet, soles) reads
+    straight down."""
+    report = adapt(progress, "retarget")
+    report(0.0, "calibrate")
     if isinstance(source_clip, str):
         source_clip = source_rig.clips[source_clip]
     ssk, tsk = source_rig.skeleton, target_rig.skeleton
@@ -169,7 +183,9 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
                              _sample_times(source_clip), source_what, target_what, str(exc))
         if fields is None:
             raise
+        report(1.0, "clip")
         return RetargetResult(**fields)
+    report(0.2, "map")
     humanoid = src.kind == "humanoid"
     if map is None:
         map = auto_map(ssk, src.points, tsk, tgt.points, source_what, target_what) \
@@ -195,6 +211,7 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
     s_points = src.contacts
     if not humanoid:
         contact, s_points, s_legs = leg_contacts(src, tgt, inverse, contact)
+    report(0.4, "transfer")
     rot, pairs = transfer_rotations(src, tgt, inverse, smats, scal, rf,
                                     contact if humanoid else None)
     scale = tgt.hip_height / src.hip_height
@@ -215,6 +232,7 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
         heights += shift
     mats = raw
     if clean_feet:
+        report(0.6, "feet")
         if humanoid:
             rot, drop = hold_feet(tsk, tgt, rot, raw, contact, tgt.contacts, times, inverse)
         else:
@@ -231,6 +249,7 @@ def retarget_result(source_rig, source_clip, target_rig, map=None, name=None,
                                        times, inverse, target_what)
     clip = to_clip(tsk, mats, rot, times, name or source_clip.name, source_clip, hips,
                    tgt.points[hips])
+    report(1.0, "clip")
     return RetargetResult(clip, dict(map), src, tgt, facing, scale, times, smats, raw, mats,
                           contact, s_floor, pairs, list(s_points), list(tgt.contacts),
                           facing_note)
