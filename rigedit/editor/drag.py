@@ -64,6 +64,9 @@ class PoseDrag:
         document.select(self.joint)
         self.start = document.pose_snapshot()
         self.work = document.pose.copy()
+        # IK starts each step from the pose at the press: its forward kinematics is computed
+        # once here, so a step runs FK once (the view's, for the new pose), not twice
+        self.start_model = document.rig.joint_matrices(self.work)
         document.begin_drag()
 
     def step(self, target):
@@ -72,7 +75,7 @@ class PoseDrag:
         d = self.document
         self.work.set_array(self.start)
         drag_joint(d.skeleton, self.work, self.joint, target, self.chain_length,
-                   fk=d.rig.joint_matrices)
+                   fk=lambda _pose: self.start_model)
         d.set_pose(self.work)
 
     def end(self, label=None):

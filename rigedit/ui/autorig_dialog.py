@@ -3,7 +3,7 @@
 bind (edit) mode, so the user can fix joints at once; when the result is NOT SURE the status
 bar says why and the first joint in doubt is selected.
 
-The work runs through :meth:`MainWindow.run_job` (progress bar with the stage's name, Cancel).
+The work runs through :class:`~rigedit.ui.jobs.JobRunner` (progress bar with the stage's name, Cancel).
 Bad input (a mesh that is not closed, a template file that is not a skeleton, a mesh with
 nothing like the template's limbs) shows through the window's error path and the open document
 stays as it was; so does a cancel.
@@ -13,6 +13,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from PyQt5 import QtCore, QtWidgets
+
+from .menus import make_action
 
 __all__ = ["AutorigDialog", "AutorigAction", "AXES", "describe_report"]
 
@@ -193,33 +195,55 @@ class _StageRelay(QtCore.QObject):
 
 
 class AutorigAction:
-    """File > Auto-rig mesh of a :class:`~rigedit.ui.main_window.MainWindow`."""
+    """File > Auto-rig mesh.
 
-    def __init__(self, window):
-        self.w = window
+    Parameters
+    ----------
+    document : Document
+    services : Services
+    replacing : callable
+        ``replacing(action)`` (:meth:`FileActions.replacing
+        <rigedit.ui.file_actions.FileActions.replacing>`): None when the user keeps the open
+        document, else a check to call when the new one arrives.
+    set_mode : callable
+        ``set_mode("edit")``: the result opens in bind mode.
+    """
+
+    def __init__(self, document, services, replacing, set_mode):
+        self.document = document
+        self.services = services
+        self.replacing = replacing
+        self.set_mode = set_mode
         self.dialog = None
         self.relay = _StageRelay()
         self.relay.stage.connect(self._show_stage)
         self._label = ""
 
+    def actions(self):
+        """name -> QAction for :func:`.menus.build_menus`."""
+        return {"autorig": make_action(
+            self.services.parent, "&Auto-rig mesh...", self.run, "Ctrl+Shift+A",
+            tip="Embed a template skeleton (humanoid, quadruped or a skeleton file) in a "
+                "mesh and open it in bind mode")}
+
     def run(self, *_):
         """Show the dialog (window-modal, not blocking); its Auto-rig button starts the job."""
         if self.dialog is None:
-            self.dialog = AutorigDialog(self.w)
+            self.dialog = AutorigDialog(self.services.parent)
             self.dialog.accepted.connect(lambda: self.start(**self.dialog.arguments()))
         self.dialog._validate()
         self.dialog.open()
         return self.dialog
 
     def _show_stage(self, stage):
-        if self.w.job is not None and self._label:
-            self.w.progress.setFormat(f"{self._label}: {stage} %p%")
+        if self._label:
+            self.services.jobs.set_stage(self._label, stage)
 
     def start(self, mesh, template="humanoid", up=None, forward=None):
         """Auto-rig ``mesh`` off the UI thread; the result becomes the document. Returns
         the job (None when another job runs)."""
         mesh = Path(mesh)
-        check = self.w.files.replacing("auto-rigging a mesh")
+        check = self.replacing("auto-rigging a mesh")
         if check is None:
             return None
         relay = self.relay
@@ -240,7 +264,8 @@ class AutorigAction:
             return autorig(str(mesh), template=template, up=up, forward=forward,
                            progress=progress)
 
-        return self.w.run_job(self._label, work, lambda rig: self._done(mesh, rig, check))
+        return self.services.run_job(self._label, work,
+                                     lambda rig: self._done(mesh, rig, check))
 
     def _done(self, mesh, rig, check=lambda: True):
         if not check():
@@ -248,14 +273,14 @@ class AutorigAction:
         rig.path = None  # a new document: Save asks where
         if not rig.name:
             rig.name = mesh.stem
-        self.w.document.set_rig(rig, modified=True)
-        self.w.set_mode("edit")
+        self.document.set_rig(rig, modified=True)
+        self.set_mode("edit")
         doubtful = [n for n in getattr(getattr(rig, "autorig_report", None), "doubtful", [])
                     if n in rig.skeleton.index]
         if doubtful:   # the first joint in doubt, ready to drag (the status bar says why)
-            self.w.document.select(rig.skeleton.index[doubtful[0]])
+            self.document.select(rig.skeleton.index[doubtful[0]])
         about = describe_report(getattr(rig, "autorig_report", None))
         # short enough for the status bar beside the mode label; counts are in Info
-        self.w.status(f"Auto-rigged {mesh.name}" + (f": {about}" if about else "")
+        self.services.status(f"Auto-rigged {mesh.name}" + (f": {about}" if about else "")
                       + "; drag joints to fix them")
         return rig

@@ -40,11 +40,17 @@ def _interval_from_env():
 
 
 class Autosave(QtCore.QObject):
-    """Writes the window's document to this editor's recovery entry.
+    """Writes the document to this editor's recovery entry.
 
     Parameters
     ----------
-    window : MainWindow
+    parent : QObject
+        Owns the timer (the window).
+    document : Document
+    status : callable
+        ``status(text)``: a failed write is said there.
+    interacting : callable, optional
+        ``interacting()`` is True while a gizmo drag is held (no write then).
     interval : float, optional
         Seconds between checks (``RIGEDIT_AUTOSAVE_SECONDS`` or 120 by default; 0: no
         timer).
@@ -62,9 +68,11 @@ class Autosave(QtCore.QObject):
 
     _windows = 0
 
-    def __init__(self, window, interval=None):
-        super().__init__(window)
-        self.window = window
+    def __init__(self, parent, document, status, interacting=lambda: False, interval=None):
+        super().__init__(parent)
+        self.document = document
+        self.status = status
+        self.interacting = interacting
         Autosave._windows += 1  # each window of a process has its own entry
         self.folder = recovery.entry_folder(window=Autosave._windows)
         self.writes = 0
@@ -75,7 +83,7 @@ class Autosave(QtCore.QObject):
         self._written_in_thread.connect(self._thread_signalled)
         self.timer = QtCore.QTimer(self)
         self.timer.timeout.connect(self.tick)
-        window.document.subscribe(self._on_document)
+        document.subscribe(self._on_document)
         self.set_interval(_interval_from_env() if interval is None else interval)
 
     def set_interval(self, seconds):
@@ -83,10 +91,6 @@ class Autosave(QtCore.QObject):
         self.timer.stop()
         if self.interval > 0:
             self.timer.start(int(round(self.interval * 1000)))
-
-    @property
-    def document(self):
-        return self.window.document
 
     def _on_document(self, event, **info):
         # Saved, or undone back to the saved state: nothing to recover any more.
@@ -96,7 +100,7 @@ class Autosave(QtCore.QObject):
     def tick(self):
         """The timer's check: write when the document changed; wait while a drag is under
         way (its intermediate pose is not an edit yet)."""
-        if self.document.dragging or getattr(self.window, "interacting", False):
+        if self.document.dragging or self.interacting():
             return False
         return self.save(background=True)
 
@@ -166,7 +170,7 @@ class Autosave(QtCore.QObject):
                 recovery.remove_entry(self.folder)
             return
         if error is not None:
-            self.window.status(f"Autosave failed: {error}")
+            self.status(f"Autosave failed: {error}")
             return
         self._written = revision
         self.writes += 1
@@ -308,9 +312,10 @@ _SIGNALS = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGINT", "SIGHUP
                  if hasattr(signal, name))  # no SIGHUP on Windows
 
 
-def install_signal_handlers(app, window, signals=_SIGNALS):
-    """On a termination signal, write the recovery snapshot and quit with status
-    128 + signal (the entry stays: the next start offers it).
+def install_signal_handlers(app, autosave, keep_recovery, signals=_SIGNALS):
+    """On a termination signal, write the recovery snapshot with ``autosave`` and quit with
+    status 128 + signal; ``keep_recovery()`` is called first so that closing keeps the entry
+    (the next start offers it).
 
     Python runs signal handlers only between bytecodes, and a Qt event loop may wait in C
     for a long time: ``signal.set_wakeup_fd`` writes to a socket that a QSocketNotifier
@@ -334,9 +339,9 @@ def install_signal_handlers(app, window, signals=_SIGNALS):
     def on_signal(signum, _frame):
         name = signal.Signals(signum).name
         errors_hook.logger().warning("%s received: writing the recovery snapshot", name)
-        window.autosave.crash_save()
-        window.autosave.stop()
-        window.keep_recovery = True
+        autosave.crash_save()
+        autosave.stop()
+        keep_recovery()
         app.exit(128 + signum)
 
     for s in signals:

@@ -154,7 +154,8 @@ def enable_faulthandler():
 
 
 class ErrorDisplay:
-    """How a window shows unexpected errors: a red label in the status bar that stays (the
+    """How a window shows unexpected errors (``status_bar``: its status bar; ``parent``: the
+    dialog's parent): a red label in the status bar that stays (the
     status line itself is overwritten by the next "Posed knee_L") naming what failed, and one
     non-modal dialog, reused while it is open, with a count.
 
@@ -168,15 +169,16 @@ class ErrorDisplay:
         Unexpected errors so far.
     """
 
-    def __init__(self, window):
-        self.window = window
+    def __init__(self, status_bar, parent):
+        self.status_bar = status_bar
+        self.parent = parent
         self.count = 0
         self.dialog = None
         self.label = QtWidgets.QLabel()
         self.label.setStyleSheet("color: #ff6b6b; font-weight: bold")
         self.label.setVisible(False)
         self.label.setMaximumWidth(640)  # long messages are cut; the tooltip has it all
-        window.statusBar().insertPermanentWidget(0, self.label)
+        status_bar.insertPermanentWidget(0, self.label)
 
     def show(self, what, summary, saved=False):
         """Show one error: ``what`` failed (None: not known, as for a Qt slot, whose
@@ -188,7 +190,7 @@ class ErrorDisplay:
         self.label.setText(headline)
         self.label.setToolTip(f"{headline}\nDetails in {log}")
         self.label.setVisible(True)
-        self.window.statusBar().showMessage(f"Error; details in {log}")
+        self.status_bar.showMessage(f"Error; details in {log}")
         text = (f"{what} failed unexpectedly:\n{summary}" if what
                 else f"An unexpected error happened:\n{summary}")
         text += ("\n\n" + ("Your work was written to a recovery file. " if saved else "")
@@ -198,7 +200,7 @@ class ErrorDisplay:
         box = self.dialog
         if box is None or not box.isVisible():
             box = QtWidgets.QMessageBox(QtWidgets.QMessageBox.Critical, "rigedit: error", "",
-                                        QtWidgets.QMessageBox.Ok, self.window)
+                                        QtWidgets.QMessageBox.Ok, self.parent)
             box.setModal(False)  # the editor stays usable (and can be saved) behind it
             box.finished.connect(lambda _: self.label.setVisible(False))
             self.dialog = box

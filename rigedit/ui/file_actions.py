@@ -1,5 +1,5 @@
 """The File menu's work: open, save, export, weights. Reading and computing run in a worker
-(:meth:`MainWindow.run_job`); a bad file gives one message naming it and keeps the current rig.
+(:class:`~rigedit.ui.jobs.JobRunner`); a bad file gives one message naming it and keeps the current rig.
 """
 from __future__ import annotations
 
@@ -13,8 +13,8 @@ from ..io.rig_folder import load_rig_folder, save_rig_folder
 from ..io.rig_save import is_bundled
 from ..io.skeleton_json import save_skeleton
 from ..io.weights_npz import load_weights, save_weights
-from .autosave import confirm_unsaved_changes
 from .jobs import weights_in_chunks
+from .menus import make_action
 
 __all__ = ["FileActions", "pose_to_dict"]
 
@@ -49,22 +49,71 @@ def _load_file(path):
 
 
 class FileActions:
-    """File operations of a :class:`MainWindow` (kept apart to keep the window small)."""
+    """The File menu's open, save, export and weights actions.
 
-    def __init__(self, window):
-        self.w = window
+    Parameters
+    ----------
+    document : Document
+    services : Services
+        Status, errors, the job runner and the dialogs' parent.
+    confirm_close : callable
+        ``confirm_close()`` is True where unsaved changes are asked about (the app; not
+        scripts or tests driving the window).
+    ask_unsaved : callable
+        ``ask_unsaved(action) -> bool``: whether the unsaved changes may go before ``action``
+        ("opening another rig"): saved, or discarded by the user.
+    screenshot : callable
+        ``screenshot(path)`` writes a picture of the window.
+    quit : callable
+        File > Quit.
+    """
 
-    @property
-    def doc(self):
-        return self.w.document
+    def __init__(self, document, services, confirm_close, ask_unsaved, screenshot, quit):
+        self.doc = document
+        self.services = services
+        self.parent = services.parent
+        self.status = services.status
+        self.error = services.error
+        self.confirm_close = confirm_close
+        self.ask_unsaved = ask_unsaved
+        self.screenshot = screenshot
+        self.quit = quit
+
+    def actions(self):
+        """name -> QAction for :func:`.menus.build_menus`."""
+        p = self.parent
+        return {
+            "open_folder": make_action(p, "&Open rig folder...", self.open_folder, "Ctrl+O"),
+            "open_mesh_skeleton": make_action(p, "Open mesh + skeleton...",
+                                              self.open_mesh_skeleton),
+            "open_file": make_action(p, "Open glTF or BVH file...", self.open_file,
+                                     "Ctrl+Shift+O"),
+            "save": make_action(p, "&Save rig", self.save, "Ctrl+S"),
+            "save_as": make_action(p, "Save rig &as...", self.save_as, "Ctrl+Shift+S"),
+            "export": make_action(p, "&Export glTF or BVH...", self.export, "Ctrl+E"),
+            "export_pose": make_action(p, "Export pose (JSON)...", self.export_pose),
+            "export_skeleton": make_action(p, "Export skeleton (JSON)...",
+                                           self.export_skeleton),
+            "load_weights": make_action(p, "Load weights...", self.load_weights),
+            "save_weights": make_action(p, "Save weights...", self.save_weights),
+            "recompute_weights": make_action(
+                p, "&Recompute weights", self.recompute_weights, "Ctrl+R",
+                tip="Recompute the weights: bone heat for a mesh with faces, inverse "
+                    "distance for a point cloud; joints flagged not deforming take none"),
+            "save_screenshot": make_action(p, "Save screenshot...", self.save_screenshot),
+            "quit": make_action(p, "&Quit", self.quit, "Ctrl+Q"),
+        }
+
+    def _run(self, label, fn, on_done):
+        return self.services.run_job(label, fn, on_done)
 
     # ------------------------------------------------------------------ dialogs
     def _ask_open(self, title, filters):
-        path, _ = QtWidgets.QFileDialog.getOpenFileName(self.w, title, "", filters)
+        path, _ = QtWidgets.QFileDialog.getOpenFileName(self.parent, title, "", filters)
         return path or None
 
     def _ask_save(self, title, name, filters):
-        path, _ = QtWidgets.QFileDialog.getSaveFileName(self.w, title, name, filters)
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(self.parent, title, name, filters)
         return path or None
 
     # ------------------------------------------------------------------ replacing the document
@@ -72,7 +121,7 @@ class FileActions:
         """Whether the open document may be replaced (``action``: by what, for the question):
         no unsaved changes, or the user saved or discarded them. Asked where closing asks
         (``confirm_close``: the app; not scripts or tests driving the window)."""
-        return not self.w.confirm_close or confirm_unsaved_changes(self.w, action=action)
+        return not self.confirm_close() or self.ask_unsaved(action)
 
     def replacing(self, action):
         """Ask before reading a new document in the background; returns None when the user
@@ -88,7 +137,7 @@ class FileActions:
                 return True  # nothing changed since the question
             if self.may_replace(action):
                 return True
-            self.w.status(f"Kept {doc.rig.name}: {action} cancelled")
+            self.status(f"Kept {doc.rig.name}: {action} cancelled")
             return False
 
         return still_ok
@@ -99,11 +148,12 @@ class FileActions:
         check = self.replacing("opening another rig")
         if check is None:
             return None
-        path = path or QtWidgets.QFileDialog.getExistingDirectory(self.w, "Open rig folder")
+        path = path or QtWidgets.QFileDialog.getExistingDirectory(self.parent,
+                                                                  "Open rig folder")
         if not path:
             return None
-        return self.w.run_job(f"Opening {Path(path).name}", lambda report: _load_folder(path),
-                              lambda rig: self._opened(rig, check))
+        return self._run(f"Opening {Path(path).name}", lambda report: _load_folder(path),
+                         lambda rig: self._opened(rig, check))
 
     def open_mesh_skeleton(self, mesh_path=None, skeleton_path=None):
         """Open a mesh file and a skeleton file; weights are computed."""
@@ -131,8 +181,8 @@ class FileActions:
             return Rig(skeleton, vertices, faces, indices, weights, name=Path(mesh_path).stem,
                        up=meta["up"])
 
-        return self.w.run_job(f"Opening {Path(mesh_path).name}", work,
-                              lambda rig: self._opened(rig, check))
+        return self._run(f"Opening {Path(mesh_path).name}", work,
+                         lambda rig: self._opened(rig, check))
 
     def open_file(self, path=None):
         """Open a glTF/GLB file or a BVH file (a skeleton and its motion, no mesh)."""
@@ -143,15 +193,15 @@ class FileActions:
                                       "Rigs and motion (*.glb *.gltf *.bvh)")
         if not path:
             return None
-        return self.w.run_job(f"Opening {Path(path).name}", lambda report: _load_file(path),
-                              lambda rig: self._opened(rig, check))
+        return self._run(f"Opening {Path(path).name}", lambda report: _load_file(path),
+                         lambda rig: self._opened(rig, check))
 
     def _opened(self, rig, check):
         if not check():
             return
         self.doc.set_rig(rig)
         notes = "".join(f"; {key}: {value}" for key, value in sorted(rig.notes.items()))
-        self.w.status(f"Opened {rig.name}: {len(rig.vertices):,} vertices, "
+        self.status(f"Opened {rig.name}: {len(rig.vertices):,} vertices, "
                       f"{len(rig.skeleton)} joints, {len(rig.clips)} clips{notes}")
 
     # ------------------------------------------------------------------ save
@@ -166,7 +216,8 @@ class FileActions:
     def save_as(self, path=None):
         """Save into a folder chosen by the user (or ``path``). A folder that holds another
         rig is replaced only after the user confirms."""
-        path = path or QtWidgets.QFileDialog.getExistingDirectory(self.w, "Save rig into folder")
+        path = path or QtWidgets.QFileDialog.getExistingDirectory(self.parent,
+                                                                  "Save rig into folder")
         if not path:
             return None
         current = self.doc.rig.path
@@ -178,7 +229,7 @@ class FileActions:
 
     def _confirm_replace(self, path):
         answer = QtWidgets.QMessageBox.question(
-            self.w, "Save rig", f"{path} already holds a rig. Replace it with this one? "
+            self.parent, "Save rig", f"{path} already holds a rig. Replace it with this one? "
             "(Its clips that this rig lacks are deleted; other files stay.)")
         return answer == QtWidgets.QMessageBox.Yes
 
@@ -188,9 +239,9 @@ class FileActions:
         try:
             action()
         except (ValueError, OSError) as exc:
-            self.w.error(title, str(exc))
+            self.error(title, str(exc))
             return False
-        self.w.status(done)
+        self.status(done)
         return True
 
     def save_to(self, path):
@@ -266,18 +317,18 @@ class FileActions:
                 # redone meanwhile) must not be applied to this one.
                 what = "another rig was opened" if self.doc.rig is not rig else \
                     "the skeleton changed"
-                self.w.status(f"Recomputed weights dropped: {what} while they were "
-                              f"computed; recompute them again")
+                self.status(f"Recomputed weights dropped: {what} while they were "
+                            f"computed; recompute them again")
                 return
             self.doc.set_weights(*result, label="Recompute weights")
-            self.w.status(f"Recomputed weights for {len(vertices):,} vertices")
+            self.status(f"Recomputed weights for {len(vertices):,} vertices")
 
-        return self.w.run_job("Computing weights",
-                              lambda report: weights_in_chunks(vertices, skeleton, method=method,
-                                                               report=report,
-                                                               faces=rig.faces), done)
+        return self._run("Computing weights",
+                         lambda report: weights_in_chunks(vertices, skeleton, method=method,
+                                                          report=report,
+                                                          faces=rig.faces), done)
 
     def save_screenshot(self, path=None):
         path = path or self._ask_save("Save screenshot", "rigedit.png", "PNG (*.png)")
-        return bool(path) and self._attempt("Screenshot", lambda: self.w.screenshot(path),
+        return bool(path) and self._attempt("Screenshot", lambda: self.screenshot(path),
                                             f"Saved a screenshot to {path}")

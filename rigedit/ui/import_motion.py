@@ -1,7 +1,7 @@
 """File > Import motion onto this character: retarget a BVH, glTF or rig folder's clip onto
 the open rig (:func:`rigedit.rigging.retarget_result`) and add it as a new clip.
 
-Reading the motion and retargeting run off the UI thread (:meth:`MainWindow.run_job`; the
+Reading the motion and retargeting run off the UI thread (:class:`~rigedit.ui.jobs.JobRunner`; the
 retarget cannot report its progress, so the bar is indeterminate). The joint map used is then
 shown (:class:`~rigedit.ui.joint_map_dialog.JointMapDialog`, not modal: the character stays in
 view): it can be edited there or loaded from JSON and the retarget run again, and saved, as
@@ -20,6 +20,7 @@ from PyQt5 import QtWidgets
 
 from ..animation.clip_names import check_clip_name
 from ..rigging.retarget.name_map import unmapped_parts
+from .menus import make_action
 
 __all__ = ["ImportMotion", "motion_path"]
 
@@ -60,13 +61,33 @@ def _names(names, most=8):
 
 
 class ImportMotion:
-    """The import of a :class:`~rigedit.ui.main_window.MainWindow` (kept apart from
-    :class:`~rigedit.ui.file_actions.FileActions` to keep modules small)."""
+    """File > Import motion onto this character.
 
-    def __init__(self, window):
-        self.w = window
+    Parameters
+    ----------
+    document : Document
+    services : Services
+    add_clip : callable
+        ``add_clip(clip, base_name, label)`` adds the clip as one undo step and returns its
+        name, or None (the timeline's :meth:`ClipManager.add_clip
+        <rigedit.ui.timeline_clips.ClipManager.add_clip>`).
+    """
+
+    def __init__(self, document, services, add_clip):
+        self.document = document
+        self.services = services
+        self.parent = services.parent
+        self.status = services.status
+        self.error = services.error
+        self.add_clip = add_clip
         self.ctx = None      # the import under way: motion, clip, target, last result
         self.dialog = None   # its joint map dialog
+
+    def actions(self):
+        """name -> QAction for :func:`.menus.build_menus`."""
+        return {"import_motion": make_action(
+            self.parent, "Import motion onto this character...", self.run,
+            tip="Retarget a BVH, glTF or rig folder's clip onto this character as a new clip")}
 
     def run(self, path=None):
         """Ask for a motion file (or take ``path``) and start reading it. Returns the job."""
@@ -74,12 +95,13 @@ class ImportMotion:
             path = None
         if path is None:
             path, _ = QtWidgets.QFileDialog.getOpenFileName(
-                self.w, "Import motion onto this character", "", FILTERS)
+                self.parent, "Import motion onto this character", "", FILTERS)
         if not path:
             return None
         path = motion_path(path)
-        return self.w.run_job(f"Reading {path.name}", lambda report: _load_motion(path),
-                              lambda source: self._loaded(path, source))
+        return self.services.run_job(f"Reading {path.name}",
+                                     lambda report: _load_motion(path),
+                                     lambda source: self._loaded(path, source))
 
     def _loaded(self, path, source):
         """Pick the clip (asking when there are several), then retarget off the UI thread."""
@@ -89,11 +111,11 @@ class ImportMotion:
         name = names[0]
         if len(names) > 1:
             name, ok = QtWidgets.QInputDialog.getItem(
-                self.w, "Import motion", f"Clip of {path.name}:", names, 0, False)
+                self.parent, "Import motion", f"Clip of {path.name}:", names, 0, False)
             if not ok:
-                self.w.status("Import motion: cancelled")
+                self.status("Import motion: cancelled")
                 return None
-        doc = self.w.document
+        doc = self.document
         # the job reads a snapshot of the clips: the user may edit them meanwhile
         ctx = SimpleNamespace(path=path, source=source, clip=name, rig=doc.rig,
                               skeleton=doc.skeleton, res=None,
@@ -129,9 +151,9 @@ class ImportMotion:
 
         if self.dialog is not None:
             self.dialog.set_busy(True)
-        job = self.w.run_job(f"Retargeting {ctx.path.name}", work,
-                             lambda res: self._retargeted(ctx, res, mapping, how),
-                             on_cancel=lambda: self._idle(ctx))
+        job = self.services.run_job(f"Retargeting {ctx.path.name}", work,
+                                    lambda res: self._retargeted(ctx, res, mapping, how),
+                                    on_cancel=lambda: self._idle(ctx))
         if job is None:
             self._idle(ctx)
         return job
@@ -148,7 +170,7 @@ class ImportMotion:
         if isinstance(res, ValueError):
             ctx.res = None
             text = f"No clip: {res}"
-            self.w.error("Import motion", str(res))
+            self.error("Import motion", str(res))
         else:
             ctx.res = res
             mapped = len(res.mapping)
@@ -183,7 +205,7 @@ class ImportMotion:
 
         if self.dialog is None:
             d = JointMapDialog(ctx.source.skeleton.names, ctx.skeleton.names,
-                               f"{ctx.path.name}, clip {ctx.clip}", self.w)
+                               f"{ctx.path.name}, clip {ctx.clip}", self.parent)
             d.retarget.connect(self.retarget)
             d.load_requested.connect(self.load_map)
             d.save_requested.connect(self.save_map)
@@ -205,7 +227,7 @@ class ImportMotion:
         ctx = self.ctx
         if not isinstance(path, (str, Path)):
             path, _ = QtWidgets.QFileDialog.getOpenFileName(
-                self.dialog or self.w, "Load joint map", "", MAP_FILTERS)
+                self.dialog or self.parent, "Load joint map", "", MAP_FILTERS)
         if not path or ctx is None:
             return None
         from ..rigging import load_map
@@ -213,7 +235,7 @@ class ImportMotion:
         try:
             mapping = load_map(path, ctx.source.skeleton, ctx.skeleton)
         except (ValueError, OSError) as exc:
-            self.w.error("Load joint map", str(exc))
+            self.error("Load joint map", str(exc))
             return None
         if self.dialog is not None:
             self.dialog.set_mapping(mapping)
@@ -233,15 +255,15 @@ class ImportMotion:
         try:
             save_map(path, self.dialog.mapping())
         except (ValueError, OSError) as exc:
-            self.w.error("Save joint map", f"{path}: {exc}")
+            self.error("Save joint map", f"{path}: {exc}")
             return False
-        self.w.status(f"Saved the joint map ({len(self.dialog.mapping())} joints) to {path}")
+        self.status(f"Saved the joint map ({len(self.dialog.mapping())} joints) to {path}")
         return True
 
     def _cancel(self):
         self.ctx = None
         self._close_dialog()
-        self.w.status("Import motion: cancelled")
+        self.status("Import motion: cancelled")
 
     # ------------------------------------------------------------------ the clip
     def _add(self):
@@ -250,17 +272,17 @@ class ImportMotion:
         if ctx is None or ctx.res is None:
             return None
         path, res = ctx.path, ctx.res
-        doc = self.w.document
+        doc = self.document
         if doc.rig is not ctx.rig or doc.skeleton is not ctx.skeleton:
             what = "another rig was opened" if doc.rig is not ctx.rig else \
                 "the skeleton changed"
-            self.w.error("Import motion", f"{path}: import dropped: {what} while it was "
+            self.error("Import motion", f"{path}: import dropped: {what} while it was "
                                           f"retargeted; import it again")
             return None
         clip = res.clip
-        added = self.w.timeline.clip_manager.add_clip(clip, ctx.base, f"Import motion {path.name}")
+        added = self.add_clip(clip, ctx.base, f"Import motion {path.name}")
         if added is None:
             return None
-        self.w.status(f"Imported {path.name} as clip {added!r} ({clip.duration:.2f} s): "
+        self.status(f"Imported {path.name} as clip {added!r} ({clip.duration:.2f} s): "
                       f"{ctx.summary}")
         return added

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import threading
 
-from PyQt5 import QtCore
+from PyQt5 import QtCore, QtWidgets
 
 from ..binding.weights import compute_weights, default_method
 
-__all__ = ["Cancelled", "Job", "JobsMixin", "weights_in_chunks"]
+__all__ = ["Cancelled", "Job", "JobRunner", "weights_in_chunks"]
 
 
 class Cancelled(Exception):
@@ -75,77 +75,130 @@ class Job(QtCore.QThread):
             self.succeeded.emit(result)
 
 
-class JobsMixin:
-    """:meth:`run_job` and :meth:`cancel_job` of :class:`~rigedit.ui.main_window.MainWindow`
-    (which has ``job``, ``progress``, ``cancel_button``, ``status``, ``error``,
-    ``report_exception`` and ``_update_undo_actions``)."""
+class JobRunner(QtCore.QObject):
+    """Runs one :class:`Job` at a time with the status bar's progress bar and Cancel button.
 
-    def run_job(self, label, fn, on_done, on_cancel=None):
+    Parameters
+    ----------
+    status_bar : QStatusBar
+        Gets the progress bar and the Cancel button (hidden while no job runs).
+    status : callable
+        ``status(text)``.
+    error : callable
+        ``error(title, message)`` for bad input (a ``ValueError``, a file that cannot be read).
+    unexpected_error : callable
+        ``unexpected_error(what, summary)`` for a bug in the job.
+    report_exception : callable
+        ``report_exception(what)`` inside the ``except`` of a failed ``on_done``.
+
+    Attributes
+    ----------
+    job : Job or None
+        The job running now.
+    progress : QProgressBar
+    cancel_button : QPushButton
+    changed : pyqtSignal()
+        A job started or ended (what Undo would do may have changed).
+    """
+
+    changed = QtCore.pyqtSignal()
+
+    def __init__(self, status_bar, status, error, unexpected_error, report_exception):
+        super().__init__(status_bar)
+        self.status = status
+        self.error = error
+        self.unexpected_error = unexpected_error
+        self.report_exception = report_exception
+        self.job = None
+        self.progress = QtWidgets.QProgressBar()
+        self.progress.setMaximumWidth(220)
+        self.progress.setVisible(False)
+        self.cancel_button = QtWidgets.QPushButton("Cancel")
+        self.cancel_button.setVisible(False)
+        self.cancel_button.clicked.connect(self.cancel)
+        status_bar.addPermanentWidget(self.progress)
+        status_bar.addPermanentWidget(self.cancel_button)
+
+    def current(self):
+        """The job running now, or None."""
+        return self.job
+
+    def set_stage(self, label, stage):
+        """Name the stage of the job ``label`` on the progress bar (when it still runs)."""
+        if self.job is not None and self.job.label == label:
+            self.progress.setFormat(f"{label}: {stage} %p%")
+
+    def run(self, label, fn, on_done, on_cancel=None):
         """Run ``fn(report)`` off the UI thread with a progress bar and a Cancel button;
-        ``on_done(result)`` runs on the main thread. Returns the :class:`Job`."""
+        ``on_done(result)`` runs on the main thread. Returns the :class:`Job`, or None (with
+        a message) when another job runs."""
         if self.job is not None:
             self.error("Busy", f"busy with '{self.job.label}': wait for it to finish, or "
                                f"cancel it, then try '{label}' again")
             return None
         job = Job(label, fn, self)
         self.job = job
+        self._show(label)
+        job.progress.connect(self._progress)
+        job.succeeded.connect(lambda result: self._succeeded(job, on_done, result))
+        job.failed.connect(lambda msg: self._failed(job, on_cancel, msg))
+        job.cancelled.connect(lambda: self._cancelled(job, on_cancel))
+        job.finished.connect(job.deleteLater)
+        self.status(f"{label}...")
+        job.start()
+        self.changed.emit()
+        return job
+
+    def cancel(self):
+        if self.job is not None:
+            self.job.cancel()
+
+    # ------------------------------------------------------------------ the bar
+    def _show(self, label):
         self.progress.setRange(0, 100)
         self.progress.setValue(0)
         self.progress.setFormat(f"{label}: %p%")
         self.progress.setVisible(True)
         self.cancel_button.setVisible(True)
 
-        def progress(p):
-            if p < 0:
-                self.progress.setRange(0, 0)
-            else:
-                self.progress.setRange(0, 100)
-                self.progress.setValue(p)
+    def _progress(self, p):
+        if p < 0:
+            self.progress.setRange(0, 0)   # the job cannot tell: a busy bar
+        else:
+            self.progress.setRange(0, 100)
+            self.progress.setValue(p)
 
-        def finish():
-            self.job = None
-            self.progress.setVisible(False)
-            self.cancel_button.setVisible(False)
-            self._update_undo_actions()
+    def _finish(self):
+        self.job = None
+        self.progress.setVisible(False)
+        self.cancel_button.setVisible(False)
+        self.changed.emit()
 
-        def ok(result):
-            finish()
-            try:
-                on_done(result)
-            except ValueError as exc:
-                self.error(label, str(exc))
-            except Exception:  # noqa: BLE001 - a bug: shown and logged, the editor goes on
-                self.report_exception(label)
+    # ------------------------------------------------------------------ the outcome
+    def _succeeded(self, job, on_done, result):
+        self._finish()
+        try:
+            on_done(result)
+        except ValueError as exc:
+            self.error(job.label, str(exc))
+        except Exception:  # noqa: BLE001 - a bug: shown and logged, the editor goes on
+            self.report_exception(job.label)
 
-        def failed(msg):
-            finish()
-            if on_cancel:
-                on_cancel()
-            # after on_cancel, so that its status does not hide the error
-            if job.unexpected:  # a bug: logged by the job, shown as one
-                self.show_unexpected_error(label, msg)
-            else:
-                self.error(label, msg)
+    def _failed(self, job, on_cancel, msg):
+        self._finish()
+        if on_cancel:
+            on_cancel()
+        # after on_cancel, so that its status does not hide the error
+        if job.unexpected:  # a bug: logged by the job, shown as one
+            self.unexpected_error(job.label, msg)
+        else:
+            self.error(job.label, msg)
 
-        def cancelled():
-            finish()
-            self.status(f"{label}: cancelled")
-            if on_cancel:
-                on_cancel()
-
-        job.progress.connect(progress)
-        job.succeeded.connect(ok)
-        job.failed.connect(failed)
-        job.cancelled.connect(cancelled)
-        job.finished.connect(job.deleteLater)
-        self.status(f"{label}...")
-        job.start()
-        self._update_undo_actions()
-        return job
-
-    def cancel_job(self):
-        if self.job is not None:
-            self.job.cancel()
+    def _cancelled(self, job, on_cancel):
+        self._finish()
+        self.status(f"{job.label}: cancelled")
+        if on_cancel:
+            on_cancel()
 
 
 def weights_in_chunks(vertices, skeleton, method=None, report=None, faces=None):

@@ -18,7 +18,7 @@ class RestRebind:
     document : Document
     run_job : callable
         ``run_job(label, fn, done, cancelled)`` -> Job or None (see
-        :meth:`~rigedit.ui.jobs.JobsMixin.run_job`).
+        :meth:`~rigedit.ui.jobs.JobRunner.run`).
     current_job : callable
         ``current_job()`` -> the Job running now, or None.
     refresh_view : callable

@@ -15,18 +15,23 @@ from PyQt5 import QtCore, QtWidgets
 from ..errors import RigFileError
 from ..render.camera import camera_state
 from ..render.recorder import RecordingCancelled, record_clip
+from .menus import make_action
 
-__all__ = ["RecordDialog", "record_video"]
+__all__ = ["RecordDialog", "RecordVideo", "record_video"]
 
 
-def record_video(window, path, fps=30, duration=None, size=(1280, 720), start=0.0,
-                 camera="view", orbit=360.0, clip=None, follow_root=False, progress=True,
-                 **options):
-    """Record the window's current clip (or ``clip``, a name) to ``path``.
+def record_video(document, view, status, path, fps=30, duration=None, size=(1280, 720),
+                 start=0.0, camera="view", orbit=360.0, clip=None, follow_root=False,
+                 progress=True, parent=None, **options):
+    """Record the document's current clip (or ``clip``, a name) to ``path``.
 
     Parameters
     ----------
-    window : MainWindow
+    document : Document
+    view : SceneView
+        The editor's view: its camera and skinning method are the recording's.
+    status : callable
+        ``status(text)``.
     path : str or Path
         ``.mp4`` or ``.gif``.
     fps : float
@@ -43,26 +48,28 @@ def record_video(window, path, fps=30, duration=None, size=(1280, 720), start=0.
         Move the camera with the root's horizontal motion.
     progress : bool
         Show a progress dialog with Cancel (processes Qt events between frames).
+    parent : QWidget, optional
+        The progress dialog's parent (window-modal over it).
 
     Returns
     -------
     frames : int
         Frames written, or 0 when cancelled (no file is then left behind).
     """
-    doc = window.document
+    doc = document
     name = clip if clip is not None else doc.current_clip
     clip_obj = doc.clips.get(name) if name is not None else None
     if duration is None:
         end = clip_obj.duration if clip_obj is not None and clip_obj.duration > 0 else 1.0
         duration = max(end - start, 1.0 / fps)
-    cam = camera if isinstance(camera, dict) else camera_state(window.plotter.camera)
+    cam = camera if isinstance(camera, dict) else camera_state(view.plotter.camera)
     turn = float(orbit) if camera == "orbit" else 0.0
     dialog = None
     callback = None
     if progress:
         total = max(1, int(round(duration * fps)))
         dialog = QtWidgets.QProgressDialog(f"Recording {Path(path).name}...", "Cancel", 0, total,
-                                           window)
+                                           parent)
         dialog.setWindowTitle("Export video")
         dialog.setWindowModality(QtCore.Qt.WindowModal)
         dialog.setMinimumDuration(0)
@@ -73,32 +80,31 @@ def record_video(window, path, fps=30, duration=None, size=(1280, 720), start=0.
             dialog.setValue(done)
             QtWidgets.QApplication.processEvents()
             return not dialog.wasCanceled()
-    options.setdefault("skinning", window.scene.skinning)  # as the view shows it (LBS/DQS)
+    options.setdefault("skinning", view.scene.skinning)  # as the view shows it (LBS/DQS)
     try:
         n = record_clip(doc.rig, clip_obj, path, fps=fps, duration=duration, size=size,
                         start=start, camera=cam, orbit=turn, follow_root=follow_root,
                         progress=callback, **options)
     except RecordingCancelled:
-        window.status("Export video: cancelled")
+        status("Export video: cancelled")
         return 0
     finally:
         if dialog is not None:
             dialog.reset()
             dialog.deleteLater()
         # the interactive view keeps its own plotter; repaint it in case the window was covered
-        window.plotter.update()
-    window.status(f"Recorded {n} frames to {path}")
+        view.plotter.update()
+    status(f"Recorded {n} frames to {path}")
     return n
 
 
 class RecordDialog(QtWidgets.QDialog):
     """Export settings: file, size, frame rate, time range, camera."""
 
-    def __init__(self, window):
-        super().__init__(window)
-        self.window_ = window
+    def __init__(self, document, parent=None):
+        super().__init__(parent)
         self.setWindowTitle("Export video")
-        doc = window.document
+        doc = document
         clip = doc.clips.get(doc.current_clip) if doc.current_clip else None
         end = clip.duration if clip is not None and clip.duration > 0 else 1.0
         form = QtWidgets.QFormLayout(self)
@@ -169,15 +175,39 @@ class RecordDialog(QtWidgets.QDialog):
                 "camera": "orbit" if self.orbit_radio.isChecked() else "view",
                 "orbit": self.orbit_spin.value(), "follow_root": self.follow_box.isChecked()}
 
-    @staticmethod
-    def run(window):
+
+class RecordVideo:
+    """File > Export video.
+
+    Parameters
+    ----------
+    document : Document
+    view : SceneView
+    services : Services
+    """
+
+    def __init__(self, document, view, services):
+        self.document = document
+        self.view = view
+        self.services = services
+
+    def actions(self):
+        """name -> QAction for :func:`.menus.build_menus`."""
+        return {"export_video": make_action(self.services.parent, "Export &video...", self.run)}
+
+    def record(self, path, **kwargs):
+        """:func:`record_video` of the document in the editor's view; returns the frames."""
+        return record_video(self.document, self.view, self.services.status, path,
+                            parent=self.services.parent, **kwargs)
+
+    def run(self, *_):
         """Show the dialog and record on OK; errors become one message."""
-        dialog = RecordDialog(window)
+        dialog = RecordDialog(self.document, self.services.parent)
         if dialog.exec_() != QtWidgets.QDialog.Accepted:
             return 0
         kwargs = dialog.settings()
         try:
-            return record_video(window, kwargs.pop("path"), **kwargs)
+            return self.record(kwargs.pop("path"), **kwargs)
         except (RigFileError, ValueError, OSError) as exc:
-            window.error("Export video", str(exc))
+            self.services.error("Export video", str(exc))
             return 0

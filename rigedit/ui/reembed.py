@@ -4,7 +4,7 @@ bind mode are pinned (hints) and the embedding runs again for the others.
 The joints moved are those whose rest position left where the auto-rig (or the last re-embed)
 put them (``rig.autorig_report.embedded``; a rest move keeps the other joints' positions), and
 those pinned by the last re-embed stay pinned where they are now. The work runs off the UI
-thread through :meth:`MainWindow.run_job` (progress bar, Cancel), as File > Auto-rig mesh does:
+thread through :class:`~rigedit.ui.jobs.JobRunner` (progress bar, Cancel), as File > Auto-rig mesh does:
 :func:`rigedit.autorig` on the character's own mesh (already standing +Y up, facing +Z) with
 the same template, weights method and clips. The result replaces the character as a new
 auto-rig does (name, folder and texture kept; the undo history starts again: the skeleton,
@@ -14,6 +14,8 @@ status message rather than lose them.
 from __future__ import annotations
 
 import numpy as np
+
+from .menus import make_action
 
 __all__ = ["ReembedAction", "moved_joints", "MOVED"]
 
@@ -60,32 +62,47 @@ def moved_joints(skeleton, report):
 
 
 class ReembedAction:
-    """File > Re-embed around the joints I moved, of a
-    :class:`~rigedit.ui.main_window.MainWindow`."""
+    """File > Re-embed around the joints I moved.
+
+    Parameters
+    ----------
+    document : Document
+    services : Services
+    set_mode : callable
+        ``set_mode("edit")``: the result opens in bind mode.
+    """
 
     LABEL = "Re-embedding"
 
-    def __init__(self, window):
-        self.w = window
+    def __init__(self, document, services, set_mode):
+        self.document = document
+        self.services = services
+        self.set_mode = set_mode
+
+    def actions(self):
+        """name -> QAction for :func:`.menus.build_menus`."""
+        return {"reembed": make_action(
+            self.services.parent, "Re-embed around the joints I moved", self.run,
+            tip="After an auto-rig: pin the joints dragged in bind mode and place the others "
+                "again around them")}
 
     def run(self, *_):
         """Start the re-embedding; returns the job, or None (with a status message) when
         there is nothing to do or another job runs."""
-        w = self.w
-        doc = w.document
+        doc, status, job = self.document, self.services.status, self.services.jobs.job
         rig = doc.rig
         report = getattr(rig, "autorig_report", None)
         try:
             hints = moved_joints(doc.skeleton, report)
         except ValueError as exc:
-            w.status(f"Re-embed: {exc}")
+            status(f"Re-embed: {exc}")
             return None
         if not hints:
-            w.status("Re-embed: no joint moved since the auto-rig; in bind mode drag the "
+            status("Re-embed: no joint moved since the auto-rig; in bind mode drag the "
                      "joints that are wrong, then re-embed around them")
             return None
-        if w.job is not None:
-            w.status(f"Busy with '{w.job.label}': re-embed when it is done")
+        if job is not None:
+            status(f"Busy with '{job.label}': re-embed when it is done")
             return None
         top = doc.undo_stack.top
         template, weights = report.template, rig.weights_method or "heat"
@@ -102,21 +119,22 @@ class ReembedAction:
                            weights=weights, clips=clips, hints=hints,
                            progress=lambda f, stage=None: progress(f))
 
-        return w.run_job(label, work, lambda new: self._done(rig, top, new, sorted(hints)))
+        return self.services.run_job(label, work,
+                                     lambda new: self._done(rig, top, new, sorted(hints)))
 
     def _done(self, rig, top, new, pinned):
-        w, doc = self.w, self.w.document
+        doc, status = self.document, self.services.status
         if doc.rig is not rig or doc.undo_stack.top is not top:
-            w.status("Re-embed dropped: the character changed while it ran; re-embed again")
+            status("Re-embed dropped: the character changed while it ran; re-embed again")
             return None
         new.name, new.path = rig.name, rig.path
         if getattr(rig, "surface", None) is not None and len(new.vertices) == len(rig.vertices):
             new.surface = rig.surface   # same vertices in the same order: the texture holds
         new.autorig_report.source = rig.autorig_report.source
         doc.set_rig(new, modified=True)
-        w.set_mode("edit")
+        self.set_mode("edit")
         shown = ", ".join(pinned[:6]) + (f" and {len(pinned) - 6} more" if len(pinned) > 6
                                          else "")
-        w.status(f"Re-embedded around {shown}; the other joints placed again "
+        status(f"Re-embedded around {shown}; the other joints placed again "
                  f"(cost {new.autorig_report.cost:.3g})")
         return new

@@ -25,13 +25,29 @@ from ..render.brush_circle import BrushCircle
 from ..render.observers import add_mouse_observers
 from ..render.surface_pick import SurfacePicker, nearest_vertex, world_radius
 from .brush_panel import BrushPanel
+from ..editor.mirror import side_axis
 from ..editor.weight_stroke import WeightStroke
 
-__all__ = ["BrushPanel", "WeightBrush", "install_weight_brush"]
+__all__ = ["BrushPanel", "WeightBrush"]
 
 
 class WeightBrush:
-    """Paints skin weights with the mouse in a :class:`MainWindow`'s 3D view.
+    """Paints skin weights with the mouse in the editor's 3D view.
+
+    Parameters
+    ----------
+    document : Document
+    view : SceneView
+        The 3D view: its plotter, scene, spheres and weight paint view.
+    panel : BrushPanel
+        The brush's settings.
+    info_panel : InfoPanel
+        Shows a queried vertex's influences.
+    services : Services
+        Status, repaint, error display and the parent of the action and tool bar.
+    set_weights_view : callable
+        ``set_weights_view(True)``: turning the brush on turns the weight paint view on (its
+        menu action with it).
 
     Attributes
     ----------
@@ -44,13 +60,23 @@ class WeightBrush:
         Tracebacks of exceptions raised in the mouse callbacks (each also shown).
     circle : BrushCircle
         The brush's outline under the mouse.
+    action : QAction
+        View > Weight brush (checkable).
+    toolbar : QToolBar
+        The settings row, shown while the brush is on.
     """
 
     PRIORITY = 9.0  # below the axis handles (10), above the joint spheres (0.5) and camera
 
-    def __init__(self, window, panel):
-        self.w = window
+    def __init__(self, document, view, panel, info_panel, services, set_weights_view):
+        self.document = document
+        self.view = view
         self.panel = panel
+        self.info_panel = info_panel
+        self.status = services.status
+        self.request_render = services.request_render
+        self.report_exception = services.report_exception
+        self.set_weights_view = set_weights_view
         self.enabled = False
         self.locked = set()
         self.stroke = None
@@ -58,7 +84,7 @@ class WeightBrush:
         self._click = None  # (x, y, vertex) of a press that may become a plain click
         self.circle = BrushCircle()
         self._picker = SurfacePicker()
-        iren = window.plotter.iren.interactor
+        iren = view.plotter.iren.interactor
         self._iren = iren
         self.errors = []  # tracebacks of failed callbacks (see :meth:`on_error`)
         self._observers = add_mouse_observers(
@@ -69,13 +95,36 @@ class WeightBrush:
         iren.GetCommand(tag).SetPassiveObserver(1)
         self._passive = [tag, iren.AddObserver("LeaveEvent", self._leave)]
         panel.lock_toggled.connect(self._lock_selected)
-        window.document.subscribe(self._on_document)
+        self._build_action(services.parent)
+        document.subscribe(self._on_document)
         self._attach()
+
+    def _build_action(self, parent):
+        """The checkable "Weight brush" action (View menu and tool bar) and the tool bar row
+        of its settings, shown while it is on."""
+        action = QtWidgets.QAction("Weight brush", parent)
+        action.setCheckable(True)
+        action.setToolTip("Paint the selected joint's weights on the mesh (turns on the "
+                          "weight paint view)")
+        action.setStatusTip(action.toolTip())
+        bar = QtWidgets.QToolBar("Weight brush", parent)
+        bar.setObjectName("weight-brush")
+        bar.setMovable(False)
+        bar.addWidget(self.panel)
+        bar.setVisible(False)
+        action.toggled.connect(self.set_enabled)
+        action.toggled.connect(bar.setVisible)
+        action.setEnabled(self.view.scene.has_mesh)
+        self.action, self.toolbar = action, bar
+
+    def actions(self):
+        """name -> QAction or QToolBar for :func:`.menus.build_menus`."""
+        return {"weight_brush": self.action, "weight_brush_bar": self.toolbar}
 
     # ------------------------------------------------------------------ scene
     def _attach(self):
         """Put the circle into the overlay renderer (rebuilt when a rig is opened)."""
-        overlay = getattr(self.w, "overlay", None) or self.w.plotter.renderer
+        overlay = self.view.overlay or self.view.plotter.renderer
         if not overlay.HasViewProp(self.circle.actor):
             overlay.AddViewProp(self.circle.actor)
         self._picker.reset()
@@ -86,9 +135,10 @@ class WeightBrush:
             self.cancel()
             self.locked = set()
             self._attach()
-            self.w.info_panel.show_vertex(None, [])
-            if not self.w.scene.has_mesh:
+            self.info_panel.show_vertex(None, [])
+            if not self.view.scene.has_mesh:
                 self.set_enabled(False)
+            self.action.setEnabled(self.view.scene.has_mesh)
             self._show_lock()
         elif event == "selection":
             self._show_lock()
@@ -96,24 +146,23 @@ class WeightBrush:
     # ------------------------------------------------------------------ settings
     def set_enabled(self, on):
         """Turn the brush on (the weight paint view with it) or off."""
-        on = bool(on) and self.w.scene.has_mesh
+        on = bool(on) and self.view.scene.has_mesh
         self.enabled = on
-        action = getattr(self, "action", None)
-        if action is not None and action.isChecked() != on:
-            action.setChecked(on)  # toggled() calls back here with the same value: no loop
-        if on and not self.w.weights_view:
-            self.w.set_weights_view(True)
+        if self.action.isChecked() != on:
+            self.action.setChecked(on)  # toggled() calls back here with the same value: no loop
+        if on and not self.view.weights_view:
+            self.set_weights_view(True)
         if not on:
             self.cancel()
             self.circle.actor.VisibilityOff()
-        self.w.status("Weight brush: drag on the mesh to paint the selected joint; "
+        self.status("Weight brush: drag on the mesh to paint the selected joint; "
                       "Ctrl+click shows a vertex's influences" if on else "Weight brush off")
-        self.w.request_render()
+        self.request_render()
 
     def _lock_selected(self, on):
-        j = self.w.document.selection
+        j = self.document.selection
         if j is None:
-            self.w.status("Select a joint to lock it")
+            self.status("Select a joint to lock it")
         elif on:
             self.locked.add(j)
         else:
@@ -121,7 +170,7 @@ class WeightBrush:
         self._show_lock()
 
     def _show_lock(self):
-        d = self.w.document
+        d = self.document
         names = [d.skeleton.names[j] for j in sorted(self.locked)]
         self.panel.show_lock(d.selection in self.locked, names)
 
@@ -130,15 +179,15 @@ class WeightBrush:
         """A mouse callback failed (called by :func:`.observers.record_failure` inside its
         ``except``): the stroke is dropped and the error shown."""
         self.cancel()
-        self.w.report_exception("Weight brush")
+        self.report_exception("Weight brush")
 
     def _active(self):
-        return self.enabled and self.w.weights_view and self.w.scene.has_mesh
+        return self.enabled and self.view.weights_view and self.view.scene.has_mesh
 
     def _press(self, iren):
         """Returns True when the press is the brush's (a stroke or a vertex query)."""
         x, y = iren.GetEventPosition()
-        if not self.w.scene.has_mesh or self._sphere_under(x, y):
+        if not self.view.scene.has_mesh or self._sphere_under(x, y):
             return False
         if iren.GetControlKey():
             hit = self.pick(x, y)
@@ -147,20 +196,20 @@ class WeightBrush:
             self.show_vertex(self.nearest_vertex(hit))
             return True
         if not self._active():
-            if self.w.weights_view:  # a plain click (no drag) in the view shows a vertex
+            if self.view.weights_view:  # a plain click (no drag) in the view shows a vertex
                 hit = self.pick(x, y)
                 self._click = None if hit is None else (x, y, self.nearest_vertex(hit))
             return False
         hit = self.pick(x, y)
         if hit is None:
             return False
-        d = self.w.document
+        d = self.document
         j = d.selection
         if j is None:
-            self.w.status("Select a joint to paint its weights (click its sphere or name)")
+            self.status("Select a joint to paint its weights (click its sphere or name)")
             return True
         if j in self.locked:
-            self.w.status(f"{d.skeleton.names[j]} is locked: unlock it to paint it")
+            self.status(f"{d.skeleton.names[j]} is locked: unlock it to paint it")
             return True
         self.stroke = WeightStroke(d, j)
         self.dab(hit, x, y)
@@ -189,7 +238,7 @@ class WeightBrush:
         """The mouse left the view: no circle where it no longer is."""
         if self.circle.actor.GetVisibility():
             self.circle.actor.VisibilityOff()
-            self.w.request_render()
+            self.request_render()
 
     def _click_release(self, iren, _event):
         """A passive observer: the camera style grabs the interactor's focus on a press it
@@ -200,35 +249,35 @@ class WeightBrush:
                     *np.subtract(iren.GetEventPosition(), click[:2])) <= 3:
                 self.show_vertex(click[2])
         except Exception:  # noqa: BLE001 - VTK would swallow it; show it
-            self.w.report_exception("Weight brush")
+            self.report_exception("Weight brush")
 
     # ------------------------------------------------------------------ picking
     def pick(self, x, y):
         """The point of the shown mesh under display pixel (x, y), or None
         (:meth:`SurfacePicker.pick <rigedit.render.surface_pick.SurfacePicker.pick>`)."""
-        if self.w.scene.mesh_actor is None:
+        if self.view.scene.mesh_actor is None:
             return None
-        return self._picker.pick(self.w.plotter.renderer, self.w.scene.mesh, x, y)
+        return self._picker.pick(self.view.plotter.renderer, self.view.scene.mesh, x, y)
 
     def _sphere_under(self, x, y):
         """Whether a visible joint sphere is under the mouse (the spheres stay clickable)."""
-        g = self.w.gizmos
+        g = self.view.gizmos
         return g is not None and g.pick(x, y) is not None
 
     def world_radius(self, point, pixels):
         """Scene units that ``pixels`` span on screen at the depth of ``point``."""
-        return world_radius(self.w.plotter.renderer, point, pixels)
+        return world_radius(self.view.plotter.renderer, point, pixels)
 
     def nearest_vertex(self, point):
-        return nearest_vertex(self.w.scene.mesh.points, point)
+        return nearest_vertex(self.view.scene.mesh.points, point)
 
     def _show_circle(self, x, y, on_mesh):
         self.circle.show(x, y, self.panel.radius_box.value(), on_mesh)
-        self.w.request_render()
+        self.request_render()
 
     # ------------------------------------------------------------------ painting
     def _rig_cache(self, key, make):
-        rig = self.w.document.rig
+        rig = self.document.rig
         if self._cache.get("rig") is not rig:
             self._cache = {"rig": rig}
         if key not in self._cache:
@@ -239,7 +288,7 @@ class WeightBrush:
         """Paint one dab of the stroke at surface ``point`` (mouse at display (x, y))."""
         s = self.stroke
         p = self.panel
-        d = self.w.document
+        d = self.document
         radius = self.world_radius(point, p.radius_box.value())
         self._show_circle(x, y, True)
         if not radius > 0:
@@ -249,16 +298,16 @@ class WeightBrush:
             adjacency = self._rig_cache(
                 "adjacency", lambda rig: vertex_adjacency(rig.faces, len(rig.vertices)))
         if p.mirror_box.isChecked():
-            axis = d._side_axis()
+            axis = side_axis(d.skeleton, d.mirror)
             mirror = self._rig_cache(("mirror", axis),
                                      lambda rig: mirror_vertices(rig.vertices, axis))
-        if not s.dab(np.asarray(self.w.scene.mesh.points), point, radius, p.mode,
+        if not s.dab(np.asarray(self.view.scene.mesh.points), point, radius, p.mode,
                      p.strength_box.value(), p.value_box.value(), self.locked, adjacency,
                      mirror):
             return
-        if self.w.weights_view:
-            self.w.scene.show_weights(s.column())
-        self.w.request_render()
+        if self.view.weights_view:
+            self.view.scene.show_weights(s.column())
+        self.request_render()
 
     def finish(self):
         """End the stroke: its change becomes one undo step."""
@@ -267,68 +316,27 @@ class WeightBrush:
             return
         message = s.commit()
         if message is not None:
-            self.w.status(message)
+            self.status(message)
 
     def cancel(self):
         """Drop a stroke under way (the shown colours go back to the document's)."""
         if self.stroke is not None:
             self.stroke = None
-            if self.w.weights_view:
-                self.w._show_weights()
+            if self.view.weights_view:
+                self.view.show_weights()
 
     # ------------------------------------------------------------------ vertex query
     def show_vertex(self, v):
         """Show vertex ``v``'s influences (joint names and weights) in the info panel."""
-        rig = self.w.document.rig
+        rig = self.document.rig
         b = rig.binding
         order = np.argsort(-b.weights[v])
         pairs = [(rig.skeleton.names[b.indices[v, k]], float(b.weights[v, k]))
                  for k in order if b.weights[v, k] > 0]
-        self.w.info_panel.show_vertex(v, pairs)
-        self.w.status(f"Vertex {v}: " + ", ".join(f"{n} {w:.3f}" for n, w in pairs))
+        self.info_panel.show_vertex(v, pairs)
+        self.status(f"Vertex {v}: " + ", ".join(f"{n} {w:.3f}" for n, w in pairs))
 
     def remove(self):
         for tag in self._observers + self._passive:
             self._iren.RemoveObserver(tag)
         self._observers = self._passive = []
-
-
-def install_weight_brush(window):
-    """Add the brush to ``window``: a checkable "Weight brush" action in the View menu and the
-    tool bar, its settings in a tool bar row shown while it is on, and its mouse handling in
-    the 3D view. Returns the :class:`WeightBrush`.
-    """
-    action = QtWidgets.QAction("Weight brush", window)
-    action.setCheckable(True)
-    action.setToolTip("Paint the selected joint's weights on the mesh (turns on the weight "
-                      "paint view)")
-    action.setStatusTip(action.toolTip())
-    panel = BrushPanel()
-    brush = WeightBrush(window, panel)
-    brush.action = action
-    bar = QtWidgets.QToolBar("Weight brush", window)
-    bar.setObjectName("weight-brush")
-    bar.setMovable(False)
-    bar.addWidget(panel)
-    window.addToolBarBreak()
-    window.addToolBar(bar)
-    bar.setVisible(False)
-    brush.toolbar = bar
-    action.toggled.connect(brush.set_enabled)
-    action.toggled.connect(bar.setVisible)
-    action.setEnabled(window.scene.has_mesh)
-    window.document.subscribe(lambda event, **_: event == "rig" and action.setEnabled(
-        window.scene.has_mesh))
-    view = next(a.menu() for a in window.menuBar().actions()
-                if a.text().replace("&", "") == "View")
-    _insert_after(view, window.weights_action, action)
-    tb = getattr(window, "toolbar", None)
-    if tb is not None:
-        _insert_after(tb, window.weights_action, action)
-    return brush
-
-
-def _insert_after(widget, anchor, action):
-    acts = widget.actions()
-    after = acts.index(anchor) + 1
-    widget.insertAction(acts[after] if after < len(acts) else None, action)

@@ -1,16 +1,12 @@
 """Editor toggles around skinning: DQS/LBS in the view options, the weights method of
-File > Recompute weights, and the per-joint "deforms" flag of the joint panel.
-
-Installed into a :class:`~rigedit.ui.main_window.MainWindow` by :func:`install_weight_tools`
-(kept apart from the window to keep it small).
-"""
+File > Recompute weights, and the per-joint "deforms" flag of the joint panel."""
 from __future__ import annotations
 
 import dataclasses
 
 from PyQt5 import QtWidgets
 
-__all__ = ["install_weight_tools", "skeleton_with_deform", "set_joint_deform", "set_skinning"]
+__all__ = ["WeightTools", "skeleton_with_deform", "set_joint_deform"]
 
 #: Recompute menu entries: (method, label)
 RECOMPUTE_METHODS = (("heat", "Bone heat (surface)"), ("idw", "Inverse distance (idw)"))
@@ -37,67 +33,65 @@ def set_joint_deform(document, joint, deform):
     return True
 
 
-def set_skinning(window, method):
-    """Skin the view with ``"lbs"`` (linear blend) or ``"dqs"`` (dual quaternions)."""
-    if method not in ("lbs", "dqs"):
-        raise ValueError(f"expected skinning 'lbs' or 'dqs', got {method!r}")
-    window.dqs_action.setChecked(method == "dqs")  # toggled() calls back: same value, no loop
-    window.scene.skinning = method
-    window._refresh_pose()
-    window.request_render()
+class WeightTools:
+    """View > Dual-quaternion skinning, File > Recompute weights with ▸ and the joint panel's
+    deform flag.
 
+    Parameters
+    ----------
+    parent : QWidget
+        The actions' parent.
+    document : Document
+    view : SceneView
+        Skins with LBS or DQS.
+    recompute_weights : callable
+        ``recompute_weights(method)`` (:meth:`FileActions.recompute_weights
+        <rigedit.ui.file_actions.FileActions.recompute_weights>`).
+    joint_panel : JointPanel
+        Its ``deform_toggled(joint, on)`` sets the flag.
 
-def _menu(window, title):
-    return next(a.menu() for a in window.menuBar().actions()
-                if a.text().replace("&", "") == title)
+    Attributes
+    ----------
+    dqs_action : QAction
+    recompute_menu : QMenu
+    recompute_actions : dict[str, QAction]
+        method -> its entry in the submenu.
+    """
 
+    def __init__(self, parent, document, view, recompute_weights, joint_panel):
+        self.document = document
+        self.view = view
+        dqs = self.dqs_action = QtWidgets.QAction("Dual-quaternion skinning", parent)
+        dqs.setCheckable(True)
+        dqs.setToolTip("Skin with dual quaternions (keeps volume in twists) instead of linear "
+                       "blending")
+        dqs.setStatusTip(dqs.toolTip())
+        dqs.toggled.connect(lambda on: self.set_skinning("dqs" if on else "lbs"))
+        self.recompute_menu = QtWidgets.QMenu("Recompute weights with", parent)
+        self.recompute_actions = {}
+        for method, label in RECOMPUTE_METHODS:
+            act = self.recompute_menu.addAction(label)
+            act.triggered.connect(lambda _=False, m=method: recompute_weights(m))
+            self.recompute_actions[method] = act
+        joint_panel.deform_toggled.connect(lambda j, on: set_joint_deform(document, j, on))
+        document.subscribe(self._on_document)
+        self._on_document("rig")
 
-def install_weight_tools(window):
-    """Add the DQS toggle (View menu), the Recompute weights with ▸ submenu (File menu) and the
-    joint panel's deform flag to ``window``."""
-    # --- DQS / LBS
-    dqs = QtWidgets.QAction("Dual-quaternion skinning", window)
-    dqs.setCheckable(True)
-    dqs.setToolTip("Skin with dual quaternions (keeps volume in twists) instead of linear "
-                   "blending")
-    dqs.setStatusTip(dqs.toolTip())
-    window.dqs_action = dqs
-    dqs.toggled.connect(lambda on: set_skinning(window, "dqs" if on else "lbs"))
-    view = _menu(window, "View")
-    acts = view.actions()
-    view.insertAction(acts[acts.index(window.floor_action)], dqs)
+    def actions(self):
+        """name -> QAction or QMenu for :func:`.menus.build_menus`."""
+        return {"dqs": self.dqs_action, "recompute_with": self.recompute_menu}
 
-    def keep_skinning(event, **_):
-        if event == "rig" and window.scene.skinning != ("dqs" if dqs.isChecked() else "lbs"):
-            set_skinning(window, "dqs" if dqs.isChecked() else "lbs")
+    def _on_document(self, event, **_):
+        if event != "rig":
+            return
+        method = "dqs" if self.dqs_action.isChecked() else "lbs"
+        if self.view.scene.skinning != method:   # a new scene keeps the chosen skinning
+            self.set_skinning(method)
+        self.recompute_actions["heat"].setEnabled(len(self.document.rig.faces) > 0)
 
-    window.document.subscribe(keep_skinning)
-    if dqs.isChecked():
-        set_skinning(window, "dqs")
-
-    # --- Recompute weights with a chosen method
-    file_menu = _menu(window, "File")
-    recompute = next(a for a in file_menu.actions()
-                     if a.text().replace("&", "") == "Recompute weights")
-    sub = QtWidgets.QMenu("Recompute weights with", window)
-    window.recompute_actions = {}
-    for method, label in RECOMPUTE_METHODS:
-        act = sub.addAction(label)
-        act.triggered.connect(lambda _=False, m=method: window.files.recompute_weights(m))
-        window.recompute_actions[method] = act
-    acts = file_menu.actions()
-    after = acts[acts.index(recompute) + 1]
-    file_menu.insertMenu(after, sub)
-    recompute.setToolTip("Recompute the weights: bone heat for a mesh with faces, inverse "
-                         "distance for a point cloud; joints flagged not deforming take none")
-
-    def heat_available(event=None, **_):
-        if event in (None, "rig"):
-            window.recompute_actions["heat"].setEnabled(len(window.document.rig.faces) > 0)
-
-    window.document.subscribe(heat_available)
-    heat_available()
-
-    # --- per-joint deform flag
-    window.joint_panel.deform_toggled.connect(
-        lambda j, on: set_joint_deform(window.document, j, on))
+    def set_skinning(self, method):
+        """Skin the view with ``"lbs"`` (linear blend) or ``"dqs"`` (dual quaternions)."""
+        if method not in ("lbs", "dqs"):
+            raise ValueError(f"expected skinning 'lbs' or 'dqs', got {method!r}")
+        self.dqs_action.setChecked(method == "dqs")  # toggled() calls back: same value, no loop
+        self.view.set_skinning(method)

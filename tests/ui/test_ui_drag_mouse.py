@@ -119,3 +119,47 @@ def test_non_deforming_joints_are_drawn_apart_and_follow_the_flag(window):
     window.undo_action.trigger()
     assert doc.skeleton.deform[spine]
     assert not np.allclose(g.glyphs.color_of(spine), g.glyphs.color_of(root))
+
+
+@pytest.fixture
+def fk_calls(monkeypatch):
+    """Counts forward kinematics (``local_to_model``) wherever rigedit imported it."""
+    import sys
+
+    from rigedit.model import kinematics
+
+    original = kinematics.local_to_model
+    calls = []
+
+    def counting(*args, **kwargs):
+        calls.append(1)
+        return original(*args, **kwargs)
+
+    for name, module in list(sys.modules.items()):
+        if name.startswith("rigedit") and getattr(module, "local_to_model", None) is original:
+            monkeypatch.setattr(module, "local_to_model", counting)
+    return calls
+
+
+@pytest.mark.parametrize("chain", [1, 2, 3])
+def test_a_drag_step_runs_forward_kinematics_once(window, fk_calls, chain):
+    # The IK of each step starts from the pose at the press, whose FK is computed once at
+    # the press; the step's own FK is the view's, for the new pose (issue 18).
+    doc = window.document
+    j = limb_joint(doc.skeleton)
+    window.chain_length = chain
+    window.view("side")
+    view = window.plotter
+    view.render()
+    x, y = window.gizmos.display_position(j)
+    qx, qy = x, view.height() - 1 - y  # Qt's y grows downwards
+    send_mouse(view, "press", qx, qy)
+    assert window.gizmos.active == j
+    per_step = []
+    for k in range(1, 6):
+        before = len(fk_calls)
+        send_mouse(view, "move", qx + 6 * k, qy - 4 * k)
+        per_step.append(len(fk_calls) - before)
+    send_mouse(view, "release", qx + 30, qy - 20)
+    assert len(doc.undo_stack) == 1   # the moves were drag steps
+    assert per_step == [1] * 5, per_step

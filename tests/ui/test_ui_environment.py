@@ -21,7 +21,7 @@ def test_a_ui_test_fails_without_a_display():
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "CI")}
     proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
                            "-p", "no:xvfb",
-                           "tests/test_ui_app.py::test_app_bad_rig_exits_with_message"],
+                           "tests/ui/test_ui_app.py::test_app_bad_rig_exits_with_message"],
                           cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 1, proc.stdout + proc.stderr
     assert "UI test environment: no X display" in proc.stdout

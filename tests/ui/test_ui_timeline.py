@@ -109,7 +109,7 @@ def test_a_panel_refresh_due_when_the_window_closes_does_not_run(window, qtbot):
     tl.play()
     tl.timer.stop()
     tl.set_time(0.3)           # playing: the panel's refresh is due in PANEL_PLAYBACK_MS
-    assert window._panel_timer.isActive() and shown == []
+    assert window.panels.timer.isActive() and shown == []
     tl.pause()
     window.close()
     qtbot.wait(2 * PANEL_PLAYBACK_MS)

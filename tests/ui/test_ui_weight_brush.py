@@ -67,7 +67,7 @@ def start_brush(window, joint, mode="add", radius=25, strength=0.5):
     p.set_mode(mode)
     p.radius_box.setValue(radius)
     p.strength_box.setValue(strength)
-    assert window._weights_view and window.weight_brush.enabled
+    assert window.weights_view and window.weight_brush.enabled
     window.plotter.render()
 
 
