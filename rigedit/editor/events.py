@@ -59,6 +59,9 @@ class RestChanged(Event):
     name: ClassVar[str] = "rest"
     weights: bool = True
 
+    def info(self):
+        return {}   # the old "rest" notification carried nothing
+
 
 @dataclass(frozen=True)
 class WeightsChanged(Event):
