@@ -177,3 +177,18 @@ def test_a_cancelled_recompute_changes_nothing(doc):
     with pytest.raises(Cancelled):
         cmd.recompute_weights(doc, "heat", progress=cancel)
     assert doc.rig.binding is b0 and len(doc.undo_stack) == 0
+
+
+def test_a_pose_drag_solves_from_the_press_and_can_be_cancelled(doc):
+    tip = doc.rig.joint_matrices(doc.pose)[2, :3, 3].copy()   # j2, the chain's end
+    drag = cmd.PoseDrag(doc, "j2", chain_length=1)             # j1 turns
+    assert doc.selection == 2 and doc.dragging
+    drag.step(tip + [0.5, 0, 0])
+    first = doc.pose_snapshot()
+    drag.step(tip + [0.2, 0, 0])
+    drag.step(tip + [0.5, 0, 0])    # the same target again gives the same pose: no drift
+    np.testing.assert_allclose(doc.pose_snapshot(), first, atol=1e-12)
+    assert not np.allclose(first, doc.rig.rest_pose().as_array())
+    drag.cancel()
+    assert not doc.dragging and len(doc.undo_stack) == 0
+    assert doc.pose.allclose(doc.rig.rest_pose())
