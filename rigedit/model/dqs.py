@@ -15,7 +15,7 @@ unit dual quaternions keeps it rigid. What is supported:
   Without scale the first phase is skipped. A vertex with a single influence therefore moves
   exactly as with linear blend skinning, scaled or not.
 
-The compiled kernel is :func:`rigedit.model.skinning_kernels._dqs_py`; this module's
+The compiled kernel is :func:`rigedit.model.dqs_kernels.dqs_py`; this module's
 :func:`dqs_skin` is its reference and fallback.
 """
 from __future__ import annotations

@@ -16,13 +16,13 @@ from .skinning_simd import dq_apply16 as _dq_apply16
 from .skinning_simd import dq_apply16_normals as _dq_apply16_normals
 from .skinning_simd import dq_blend4_into as _dq_blend4_into
 
-__all__ = ["SIMD_SHA256", "DQS_TASK"]
+__all__ = ["SIMD_SHA256", "DQS_TASK", "dqs_py", "rigid_dual_quaternions_py"]
 
 #: sha256 of skinning_simd.py as this kernel was last compiled and checked against it.
 SIMD_SHA256 = "aafe0734f8842c7eb9d9e60fbb1a4424939e4cdf825df3c1bc3ebf3630323ef1"
 
 
-def _dqs_py(rest, rest_normals, indices, weights, dq, signs, scale, has_scale, out,
+def dqs_py(rest, rest_normals, indices, weights, dq, signs, scale, has_scale, out,
             out_normals):
     """Dual-quaternion skinning of every vertex (Kavan et al. 2008), and of its normal when
     ``out_normals`` has rows.
@@ -94,7 +94,7 @@ def _dqs_py(rest, rest_normals, indices, weights, dq, signs, scale, has_scale, o
 
 def _dqs_task_py(rest, rest_normals, indices, weights, dq, signs, scale, out, out_normals,
                  start, stop, scaled, normals):
-    """:func:`_dqs_py` of the vertices start to stop (whole blocks of 16); ``scaled`` and
+    """:func:`dqs_py` of the vertices start to stop (whole blocks of 16); ``scaled`` and
     ``normals`` are constants where it is inlined, so each loop compiles only its own path."""
     blend = np.empty((16, 8), np.float32)
     points = np.empty((16, 3), np.float32)
@@ -117,7 +117,7 @@ def _dqs_task_py(rest, rest_normals, indices, weights, dq, signs, scale, out, ou
 def _dq_blend_block_py(indices, weights, dq, signs, first, count, blend):
     """blend[i] = the blend of vertex first + i's influences, for i < count."""
     for i in range(count):
-        # Unsigned: numba then indexes without its negative-index wraparound (see _dqs_py).
+        # Unsigned: numba then indexes without its negative-index wraparound (see dqs_py).
         v = np.uint64(first + i)
         # the strongest influence (the first: sorted) fixes the blend's hemisphere
         jp = indices[v, 0]
@@ -196,7 +196,7 @@ def _dq_apply_one_py(blend, i, points, turned, p, out, out_normals, v, normals):
             out_normals[v, 2] = nz * inv
 
 
-def _rigid_dual_quaternions_py(palette, tol, dq):
+def rigid_dual_quaternions_py(palette, tol, dq):
     """Each skinning matrix as a unit dual quaternion into ``dq`` (J, 8) f32, when every one is
     rigid: returns False (``dq`` unspecified) as soon as one's 3x3 ``A`` has ``AᵀA`` further
     than ``tol`` from the identity or a negative determinant; the caller then takes the numpy

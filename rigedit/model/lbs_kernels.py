@@ -15,7 +15,7 @@ from numba import njit, prange
 
 from .skinning_simd import blend_apply4, blend_apply4_normal
 
-__all__ = ["SIMD_SHA256", "check_groups"]
+__all__ = ["SIMD_SHA256", "check_groups", "lbs_py", "lbs_normals_py"]
 
 #: sha256 of skinning_simd.py as these kernels were last compiled and checked against it.
 SIMD_SHA256 = "aafe0734f8842c7eb9d9e60fbb1a4424939e4cdf825df3c1bc3ebf3630323ef1"
@@ -30,7 +30,7 @@ def _check_groups_py(indices, palette):
 check_groups = njit(_check_groups_py)
 
 
-def _lbs_py(rest, indices, weights, palette, out):
+def lbs_py(rest, indices, weights, palette, out):
     """LBS of every vertex: blend the influences' skinning matrices, apply to the rest point.
 
     rest (V, 3) f32; indices (V, K) i32 and weights (V, K) f32 with K a multiple of 4, each
@@ -66,8 +66,8 @@ def _lbs_py(rest, indices, weights, palette, out):
         out[v, 2] = c
 
 
-def _lbs_normals_py(rest, rest_normals, indices, weights, palette, out, out_normals):
-    """:func:`_lbs_py` plus the normals: the blended 3x3 applied to the rest normal, then
+def lbs_normals_py(rest, rest_normals, indices, weights, palette, out, out_normals):
+    """:func:`lbs_py` plus the normals: the blended 3x3 applied to the rest normal, then
     renormalised (exact for rotations and uniform scale; the usual approximation otherwise)."""
     check_groups(indices, palette)
     k_max = indices.shape[1]

@@ -100,15 +100,15 @@ class Kernels:
                 "nogil": True}
         self.numba = numba
         self.lbs = numba.njit([numba.void(f32, i32, f32, f32, f32)], **opts)(
-            lbs_kernels._lbs_py)
+            lbs_kernels.lbs_py)
         self.lbs_normals = numba.njit([numba.void(f32, f32, i32, f32, f32, f32, f32)], **opts)(
-            lbs_kernels._lbs_normals_py)
+            lbs_kernels.lbs_normals_py)
         self.dqs = numba.njit(
             [numba.void(f32, f32, i32, f32, f32, f32, f32, numba.boolean, f32, f32)], **opts)(
-            dqs_kernels._dqs_py)
+            dqs_kernels.dqs_py)
         self.rigid_dual_quaternions = numba.njit(
             [numba.boolean(numba.float64[:, :, ::1], numba.float64, f32)],
-            cache=True, nogil=True)(dqs_kernels._rigid_dual_quaternions_py)
+            cache=True, nogil=True)(dqs_kernels.rigid_dual_quaternions_py)
 
     def run(self, name, n_vertices, threads, *args):
         """Run kernel ``name`` on ``args`` with ``threads`` threads (None: one below

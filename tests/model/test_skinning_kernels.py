@@ -230,4 +230,4 @@ def test_building_the_kernels_sets_no_module_names():
     before = [dict(vars(m)) for m in modules]
     kernels = skinning_kernels.Kernels(numba)
     assert [dict(vars(m)) for m in modules] == before
-    assert kernels.lbs.py_func is lbs_kernels._lbs_py and lbs_kernels.prange is numba.prange
+    assert kernels.lbs.py_func is lbs_kernels.lbs_py and lbs_kernels.prange is numba.prange
