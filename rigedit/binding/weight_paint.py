@@ -174,21 +174,47 @@ def paint(indices, weights, num_joints, joint, verts, factors, mode="add", stren
               out_w[verts].ravel())
     cur = rows[:, joint]
     room = np.clip(1.0 - rows[:, lock].sum(axis=1), 0.0, 1.0)
-    if mode == "add":
-        target = cur + a
-    elif mode == "subtract":
-        target = cur - a
-    elif mode == "set":
-        target = cur + a * (float(value) - cur)
-    else:
+    if mode == "smooth":
         if adjacency is None:
             raise ValueError("smooth needs the vertex adjacency")
-        col = joint_column(indices, weights, joint)
-        adj = adjacency[verts]
-        deg = np.asarray(adj.sum(axis=1)).ravel()
-        mean = np.divide(adj @ col, deg, out=cur.copy(), where=deg > 0)
-        target = cur + a * (mean - cur)
-    target = np.clip(target, 0.0, room)
+        goal = _neighbour_mean(indices, weights, joint, verts, adjacency, cur)
+    else:
+        goal = value
+    target = np.clip(_moved(mode, cur, a, goal), 0.0, room)
+    _share_the_rest(rows, joint, target, room, lock, fallback)
+    idx, vals = _top_k(rows, k, lock, min_weight)
+    out_idx[verts] = idx
+    out_w[verts] = vals
+    return out_idx, out_w
+
+
+def _moved(mode, cur, a, goal):
+    """(N,) the painted joint's weights ``cur`` after a dab of amounts ``a`` (N,): added,
+    subtracted, or moved towards ``goal`` (the set value, or the neighbours' mean)."""
+    if mode == "add":
+        return cur + a
+    if mode == "subtract":
+        return cur - a
+    if mode == "set":
+        return cur + a * (float(goal) - cur)
+    return cur + a * (goal - cur)
+
+
+def _neighbour_mean(indices, weights, joint, verts, adjacency, cur):
+    """(N,) the mean weight of ``joint`` over each of ``verts``' neighbours (``cur``, its
+    own, where it has none)."""
+    col = joint_column(indices, weights, joint)
+    adj = adjacency[verts]
+    deg = np.asarray(adj.sum(axis=1)).ravel()
+    return np.divide(adj @ col, deg, out=cur.copy(), where=deg > 0)
+
+
+def _share_the_rest(rows, joint, target, room, lock, fallback):
+    """Put ``target`` (N,) as the painted joint's weight in ``rows`` (N, J), in place, and
+    give what is left of ``room`` (what the locked joints leave) to the other unlocked
+    joints in proportion to their weights; where there are none, to the ``fallback``
+    joint, else the painted joint keeps it (``target`` is changed there too)."""
+    n = len(rows)
     others = ~lock
     others[joint] = False
     other_sum = rows[:, others].sum(axis=1)
@@ -197,16 +223,12 @@ def paint(indices, weights, num_joints, joint, verts, factors, mode="add", stren
     scale = np.divide(rest, other_sum, out=np.zeros(n), where=has_others)
     rows[:, others] *= scale[:, None]
     lonely = ~has_others & (rest > 0)
-    if fallback is not None and 0 <= fallback < num_joints and not lock[fallback] \
+    if fallback is not None and 0 <= fallback < len(lock) and not lock[fallback] \
             and fallback != joint:
         rows[lonely, fallback] = rest[lonely]
     else:
         target[lonely] = room[lonely]  # nobody to give it to: the joint keeps it
     rows[:, joint] = target
-    idx, vals = _top_k(rows, k, lock, min_weight)
-    out_idx[verts] = idx
-    out_w[verts] = vals
-    return out_idx, out_w
 
 
 def _top_k(rows, k, lock, min_weight):

@@ -130,47 +130,23 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
     k = len(idx)
     pb = np.array([slot[p] for p, _ in bones])
     cb = np.array([slot[j] for _, j in bones])
-    tb = np.array([rest[j] - rest[p] for p, j in bones])
-    factor = _proportions(template, positions, scale)[[owner[j] for _, j in bones]]
-    if template.tail is not None:   # a tail's first bone (base to tail root) keeps its length
-        roots = {template.chains[r][1] for r in np.flatnonzero(template.tail)}
-        factor[[i for i, (_, j) in enumerate(bones) if j in roots]] = 1.0
-    tb *= factor[:, None]
-    span = np.ptp(rest[idx, 1])
-    # feet: (slot, template height above the template's ground)
-    low = rest[idx, 1] - template.floor
+    tb = _template_bones(template, positions, scale, bones, owner)
     # rows of the form  x[i, dim] - coef * scale = value  (weight w)
-    rows = [([(i, 1, 1.0)], low[i], floor, W_FEET) for i in np.flatnonzero(low < FEET * span)]
-    rows += _symmetry_rows(template, idx, slot, plane)
+    rows = _feet_rows(template, idx, floor) + _symmetry_rows(template, idx, slot, plane)
     scale0 = scale
     medial_tree = cKDTree(medial) if medial is not None and len(medial) else None
     medial = medial if medial_tree is not None else None
     pinned = np.array([slot[j] for j in (pins or {}) if slot[j] >= 0], dtype=np.int64)
     pin_at = np.array([pins[j] for j in (pins or {}) if slot[j] >= 0]).reshape(-1, 3)
+    # the root's direction: to its first child's joint
+    first = [slot[j] for p, j in bones if p == root]
     for _ in range(ROUNDS):
-        # each bone turns towards its present direction by how thin its part is: limbs
-        # follow the mesh, the trunk keeps the template's directions (frames are shared)
-        cur = x[cb] - x[pb]
-        mid_depth = np.maximum(field(0.5 * (x[cb] + x[pb])), 0.0)
-        follow = 1.0 / (1.0 + (SLENDER * mid_depth / np.maximum(
-            np.linalg.norm(cur, axis=1), 1e-12)) ** 2)
-        v = np.array([Rotation.from_rotvec(follow[i] * least_rotation(tb[i], cur[i]).as_rotvec())
-                      .apply(tb[i]) for i in range(len(tb))])
+        v = _followed_bones(field, x, pb, cb, tb)
         direction = np.full((k, 3), np.nan)
-        direction[cb] = cur
-        first = [slot[j] for p, j in bones if p == root]
+        direction[cb] = x[cb] - x[pb]
         if first:
             direction[slot[root]] = x[first[0]] - x[slot[root]]
-        target = centre_joints(field, x, direction)
-        depth = np.maximum(field(target), 0.0)
-        lam = W_DATA / (1.0 + (depth / thin) ** 2)
-        if medial is not None:
-            # a joint pushed out of the mesh (a limb shorter than the template's) goes back
-            # to the nearest medial sphere centre, firmly
-            out_ = field(x) < 0.5 * field.h
-            if out_.any():
-                target[out_] = medial[medial_tree.query(x[out_])[1]]
-                lam[out_] = W_INSIDE
+        target, lam = _data_targets(field, x, direction, thin, medial, medial_tree)
         target[pinned], lam[pinned] = pin_at, W_PIN
         try:
             x_new, s_new = _solve(k, pb, cb, v, lam, target, scale0, rows, hold_scale)
@@ -185,6 +161,58 @@ def fit_joints(field, template, positions, scale, floor, hold_scale=W_SCALE_WEAK
     out = positions.copy()
     out[idx] = x
     return out, scale
+
+
+def _template_bones(template, positions, scale, bones, owner):
+    """(B, 3) each of ``bones`` (parent, joint) as the template has it, times its chain's
+    proportion factor (:func:`_proportions`; a tail's first bone keeps its length)."""
+    rest = template.rest
+    tb = np.array([rest[j] - rest[p] for p, j in bones])
+    factor = _proportions(template, positions, scale)[[owner[j] for _, j in bones]]
+    if template.tail is not None:   # a tail's first bone (base to tail root) keeps its length
+        roots = {template.chains[r][1] for r in np.flatnonzero(template.tail)}
+        factor[[i for i, (_, j) in enumerate(bones) if j in roots]] = 1.0
+    return tb * factor[:, None]
+
+
+def _feet_rows(template, idx, floor):
+    """Rows (see :func:`_solve`) holding each foot joint among ``idx`` (template height
+    above the template's ground under :data:`FEET` of the joints' span) at that height
+    times the scale above the mesh's ``floor``."""
+    rest = template.rest
+    span = np.ptp(rest[idx, 1])
+    low = rest[idx, 1] - template.floor
+    return [([(i, 1, 1.0)], low[i], floor, W_FEET) for i in np.flatnonzero(low < FEET * span)]
+
+
+def _followed_bones(field, x, pb, cb, tb):
+    """(B, 3) the template bones ``tb`` turned towards their present directions (``x[cb] -
+    x[pb]``) by how thin their part is: limbs follow the mesh, the trunk keeps the
+    template's directions (frames are shared)."""
+    cur = x[cb] - x[pb]
+    mid_depth = np.maximum(field(0.5 * (x[cb] + x[pb])), 0.0)
+    follow = 1.0 / (1.0 + (SLENDER * mid_depth / np.maximum(
+        np.linalg.norm(cur, axis=1), 1e-12)) ** 2)
+    return np.array([Rotation.from_rotvec(follow[i] * least_rotation(tb[i], cur[i]).as_rotvec())
+                     .apply(tb[i]) for i in range(len(tb))])
+
+
+def _data_targets(field, x, direction, thin, medial, medial_tree):
+    """``(target, lam)``: where each joint ``x`` (K, 3) should be, the middle of the mesh's
+    cross-section across its bone ``direction`` (K, 3), and how much that counts (more
+    where the part is thin); a joint that left the mesh goes back to the nearest medial
+    point ``medial`` (M, 3), firmly."""
+    target = centre_joints(field, x, direction)
+    depth = np.maximum(field(target), 0.0)
+    lam = W_DATA / (1.0 + (depth / thin) ** 2)
+    if medial is not None:
+        # a joint pushed out of the mesh (a limb shorter than the template's) goes back
+        # to the nearest medial sphere centre, firmly
+        out_ = field(x) < 0.5 * field.h
+        if out_.any():
+            target[out_] = medial[medial_tree.query(x[out_])[1]]
+            lam[out_] = W_INSIDE
+    return target, lam
 
 
 def _proportions(template, positions, scale):

@@ -130,12 +130,43 @@ def reduce_template(skeleton, mesh=None):
     """
     rest = skeleton.forward(skeleton.rest_local_matrices())[:, :3, 3].copy()
     parents = skeleton.parents
-    n = len(parents)
     deform = np.asarray(skeleton.deform, dtype=bool)
     if not deform.any():
         raise ValueError("the template has no deforming joint to embed")
     lo, hi = rest[deform].min(axis=0), rest[deform].max(axis=0)
     size = float(np.linalg.norm(hi - lo))
+    bone, tip = _bones_and_tips(rest, parents, size)
+    tails = _tails(rest, parents, tip, size)
+    tip &= ~tails
+    # a root is carried when it does not deform (a ground-level "root" joint)
+    carried = tip | ((parents < 0) & ~deform)
+    kept = np.flatnonzero(~carried)
+    if len(kept) < 2:
+        raise ValueError(f"the template has {len(kept)} joint(s) long enough to embed; "
+                         "expected at least two")
+    reduced, parent, chains, length = _reduced_tree(parents, kept, bone)
+    optional = _optional(parent, length)
+    mirror = _mirror(rest[reduced], rest[reduced[0]], size)
+    mirror_all = _mirror(rest, rest[reduced[0]], size)
+    middle = np.abs(rest[:, 0] - rest[reduced[0], 0]) < 0.02 * size
+    mirror_all[(mirror_all < 0) & middle] = -2
+    kept_y = rest[kept, 1]
+    floor = float(kept_y.min() - ANKLE_HEIGHT * np.ptp(kept_y))
+    height = area = np.nan
+    if mesh is not None:
+        verts = np.asarray(mesh[0], dtype=np.float64)
+        floor, height = float(verts[:, 1].min()), float(np.ptp(verts[:, 1]))
+        area = surface_area(verts, mesh[1])
+    return ReducedTemplate(rest, parents.copy(), size, floor, height, area, np.asarray(reduced),
+                           parent, chains, length, optional, mirror, carried, mirror_all,
+                           tails[reduced] & optional)
+
+
+def _bones_and_tips(rest, parents, size):
+    """``(bone, tip)``: each joint's bone length (J,) and whether it is a short tip (J,)
+    bool: below a tip, or its bone plus the longest path below it under :data:`SHORT` of
+    ``size``."""
+    n = len(parents)
     bone = np.zeros(n)
     has = parents >= 0
     bone[has] = np.linalg.norm(rest[has] - rest[parents[has]], axis=1)
@@ -148,14 +179,30 @@ def reduce_template(skeleton, mesh=None):
     for j in range(n):
         p = parents[j]
         tip[j] = p >= 0 and (tip[p] or bone[j] + reach[j] < SHORT * size)
-    tails = _tails(rest, parents, tip, size)
-    tip &= ~tails
-    # a root is carried when it does not deform (a ground-level "root" joint)
-    carried = tip | ((parents < 0) & ~deform)
-    kept = np.flatnonzero(~carried)
-    if len(kept) < 2:
-        raise ValueError(f"the template has {len(kept)} joint(s) long enough to embed; "
-                         "expected at least two")
+    return bone, tip
+
+
+def _reduced_tree(parents, kept, bone):
+    """The reduced skeleton of the ``kept`` joints: those of degree other than two among
+    them (and their root), each with its reduced parent and the chain of template joints
+    between.
+
+    Returns
+    -------
+    reduced : list of int
+        Template indices, parent before child.
+    parent : (R,) int
+        Reduced parent of each (-1 for the root).
+    chains : list of list of int
+        For r > 0, the template joints from its reduced parent to it, both ends included.
+    length : (R,) float64
+        Summed ``bone`` length of each chain.
+
+    Raises
+    ------
+    ValueError
+        When the kept joints form more than one tree.
+    """
     kept_set = set(kept.tolist())
     kept_children = {j: [c for c in np.flatnonzero(parents == j) if c in kept_set]
                      for j in kept}
@@ -184,21 +231,7 @@ def reduce_template(skeleton, mesh=None):
         parent[r] = index[p]
         chains.append(chain[::-1])
         length[r] = sum(bone[c] for c in chain[:-1])
-    optional = _optional(parent, length)
-    mirror = _mirror(rest[reduced], rest[reduced[0]], size)
-    mirror_all = _mirror(rest, rest[reduced[0]], size)
-    middle = np.abs(rest[:, 0] - rest[reduced[0], 0]) < 0.02 * size
-    mirror_all[(mirror_all < 0) & middle] = -2
-    kept_y = rest[kept, 1]
-    floor = float(kept_y.min() - ANKLE_HEIGHT * np.ptp(kept_y))
-    height = area = np.nan
-    if mesh is not None:
-        verts = np.asarray(mesh[0], dtype=np.float64)
-        floor, height = float(verts[:, 1].min()), float(np.ptp(verts[:, 1]))
-        area = surface_area(verts, mesh[1])
-    return ReducedTemplate(rest, parents.copy(), size, floor, height, area, np.asarray(reduced),
-                           parent, chains, length, optional, mirror, carried, mirror_all,
-                           tails[reduced] & optional)
+    return reduced, parent, chains, length
 
 
 def surface_area(vertices, faces):
