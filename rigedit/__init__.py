@@ -38,13 +38,15 @@ def load_rig(rig=None, weights_method=None, scale=None):
     return Rig.from_data(read_rig(rig, scale=scale), weights_method=weights_method)
 
 
-def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_feet=True):
+def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_feet=True,
+             progress=None):
     """Retarget a clip onto another character: two humanoids, or any two skeletons with legs
-    whose joints share names or are mapped (see :func:`rigedit.rigging.retarget.pipeline`)."""
+    whose joints share names or are mapped (see :func:`rigedit.rigging.retarget.pipeline`;
+    ``progress(fraction, stage)`` as in :mod:`rigedit.progress`)."""
     from .rigging.retarget.pipeline import retarget as _retarget
 
     return _retarget(source_rig, source_clip, target_rig, map=map, name=name,
-                     clean_feet=clean_feet)
+                     clean_feet=clean_feet, progress=progress)
 
 
 def autorig(mesh, template="humanoid", up=None, forward=None, weights="heat", clips=True,
