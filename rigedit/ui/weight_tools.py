@@ -2,35 +2,15 @@
 File > Recompute weights, and the per-joint "deforms" flag of the joint panel."""
 from __future__ import annotations
 
-import dataclasses
-
 from PyQt5 import QtWidgets
+
+# the flag's edit is the editor's (no Qt); kept importable from here
+from ..editor.deform import set_joint_deform, skeleton_with_deform
 
 __all__ = ["WeightTools", "skeleton_with_deform", "set_joint_deform"]
 
 #: Recompute menu entries: (method, label)
 RECOMPUTE_METHODS = (("heat", "Bone heat (surface)"), ("idw", "Inverse distance (idw)"))
-
-
-def skeleton_with_deform(skeleton, joint, deform):
-    """A copy of ``skeleton`` where ``joint`` does (True) or does not (False) take skin
-    weight at the next weights computation."""
-    flags = skeleton.deform.copy()
-    flags[joint] = bool(deform)
-    return dataclasses.replace(skeleton, deform=flags)
-
-
-def set_joint_deform(document, joint, deform):
-    """Set a joint's deform flag as one undo step (a rest edit: the binding is unchanged until
-    the weights are recomputed). Returns False when the flag already had that value."""
-    sk = document.skeleton
-    if bool(sk.deform[joint]) == bool(deform):
-        return False
-    before = document.rest_state()
-    after = (skeleton_with_deform(sk, joint, deform), before[1], before[2])
-    label = f"{'Deform' if deform else 'No deform'} {sk.names[joint]}"
-    document.push_rest_edit(label, before, after)
-    return True
 
 
 class WeightTools:
