@@ -158,18 +158,9 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order=None):
         ``clip`` (name or None), ``frames``, ``frame_time``.
     """
     rig = as_rig_data(rig)
-    if isinstance(clip, str):
-        if clip not in rig.clips:
-            raise RigFileError(path, f"expected a clip of the rig, got {clip!r}")
-        clip = rig.clips[clip]
-    if clip is None and rig.clips:
-        clip = next(iter(rig.clips.values()))
+    clip = _chosen_clip(rig, clip, path)
     sk = rig.skeleton
-    source = rig.meta.rotation_orders if order is None else {}
-    orders = [str(source.get(name, order or "ZXY")).upper() for name in sk.names]
-    for o in set(orders):
-        if sorted(o) != ["X", "Y", "Z"]:
-            raise ValueError(f"expected a rotation order of X, Y and Z, got {o!r}")
+    orders = _orders(sk.names, rig.meta.rotation_orders if order is None else {}, order)
     times, dt = bvh_frame_times(clip, fps)
     local_rot, local_t, _, frame_pos = _local_parts(_model_frames(sk, clip, times),
                                                     sk.parents)
@@ -178,47 +169,11 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order=None):
     _, offsets, rest_rot, rest_pos = _local_parts(rest_model, sk.parents)
     size = float(np.ptp(np.vstack([rest_pos, local_t[:, 0]]), axis=0).max()) or 1.0
     moves = np.abs(local_t - offsets[None]).max(axis=(0, 2)) > 1e-9 * size
-    with_pos = (sk.parents < 0) | moves
-    order_dfs, children = _depth_first(sk.parents)
-    names = _bvh_names(sk.names)
     s = float(units_per_metre)
-    euler = np.empty((len(times), len(sk), 3))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)  # gimbal lock: angles still reproduce R
-        for o in set(orders):   # one batched conversion per order
-            js = [j for j in range(len(sk)) if orders[j] == o]
-            euler[:, js] = Rotation.from_matrix(local_rot[:, js].reshape(-1, 3, 3)).as_euler(
-                o, degrees=True).reshape(len(times), len(js), 3)
-    lines = ["HIERARCHY"]
-    columns = []
-
-    def write(j, depth):
-        pad = "  " * depth
-        kind = "ROOT" if sk.parents[j] < 0 else "JOINT"
-        o = offsets[j] * s
-        chans = (("Xposition Yposition Zposition " if with_pos[j] else "")
-                 + " ".join(f"{a}rotation" for a in orders[j]))
-        lines.extend([f"{pad}{kind} {names[j]}", f"{pad}{{",
-                      f"{pad}  OFFSET {o[0]:.6f} {o[1]:.6f} {o[2]:.6f}",
-                      f"{pad}  CHANNELS {6 if with_pos[j] else 3} {chans}"])
-        if with_pos[j]:
-            columns.append(local_t[:, j] * s)
-        columns.append(euler[:, j])
-        for c in children[j]:
-            write(c, depth + 1)
-        if not children[j]:
-            end = np.zeros(3)
-            if np.all(np.isfinite(sk.tails[j])):
-                tail = rest_model[j] @ sk.inverse_bind_matrices[j] @ np.r_[sk.tails[j], 1.0]
-                end = rest_rot[j].T @ (tail[:3] - rest_pos[j]) * s
-            lines.extend([f"{pad}  End Site", f"{pad}  {{",
-                          f"{pad}    OFFSET {end[0]:.6f} {end[1]:.6f} {end[2]:.6f}",
-                          f"{pad}  }}"])
-        lines.append(f"{pad}}}")
-
-    for j in order_dfs:
-        if sk.parents[j] < 0:
-            write(j, 0)
+    lines, columns = _hierarchy(_bvh_names(sk.names), sk.parents, orders,
+                                (sk.parents < 0) | moves, offsets * s,
+                                _end_sites(sk, rest_model, rest_rot, rest_pos) * s,
+                                local_t * s, _euler(local_rot, orders))
     lines += ["MOTION", f"Frames: {len(times)}", f"Frame Time: {dt:.10g}"]
     data = np.concatenate(columns, axis=1)
     with atomic_write(path) as fh:
@@ -226,6 +181,98 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order=None):
         np.savetxt(fh, data, fmt="%.6f")
     return {"clip": None if clip is None else clip.name, "frames": len(times),
             "frame_time": dt}
+
+
+def _chosen_clip(rig, clip, path):
+    """The Clip to write: ``clip`` (a Clip or a clip name), else the rig's first, else None."""
+    if isinstance(clip, str):
+        if clip not in rig.clips:
+            raise RigFileError(path, f"expected a clip of the rig, got {clip!r}")
+        clip = rig.clips[clip]
+    if clip is None and rig.clips:
+        clip = next(iter(rig.clips.values()))
+    return clip
+
+
+def _orders(names, source, order):
+    """Each joint's rotation order: the source file's, else ``order``, else ``ZXY``."""
+    orders = [str(source.get(name, order or "ZXY")).upper() for name in names]
+    for o in set(orders):
+        if sorted(o) != ["X", "Y", "Z"]:
+            raise ValueError(f"expected a rotation order of X, Y and Z, got {o!r}")
+    return orders
+
+
+def _euler(local_rot, orders):
+    """(F, J, 3) degrees: the (F, J, 3, 3) local rotations as each joint's Euler angles."""
+    frames, joints = local_rot.shape[:2]
+    euler = np.empty((frames, joints, 3))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # gimbal lock: angles still reproduce R
+        for o in set(orders):   # one batched conversion per order
+            js = [j for j in range(joints) if orders[j] == o]
+            euler[:, js] = Rotation.from_matrix(local_rot[:, js].reshape(-1, 3, 3)).as_euler(
+                o, degrees=True).reshape(frames, len(js), 3)
+    return euler
+
+
+def _end_sites(sk, rest_model, rest_rot, rest_pos):
+    """(J, 3) each joint's End Site offset in its rest frame (metres): its bone tail, zero
+    where it has none."""
+    ends = np.zeros((len(sk), 3))
+    for j in np.flatnonzero(np.all(np.isfinite(sk.tails), axis=1)):
+        tail = rest_model[j] @ sk.inverse_bind_matrices[j] @ np.r_[sk.tails[j], 1.0]
+        ends[j] = rest_rot[j].T @ (tail[:3] - rest_pos[j])
+    return ends
+
+
+def _hierarchy(names, parents, orders, with_pos, offsets, ends, translations, euler):
+    """The HIERARCHY lines and the motion's columns in channel order.
+
+    Parameters
+    ----------
+    names : list[str]
+        BVH-safe joint names.
+    parents : (J,) int
+    orders : list[str]
+        Rotation order of each joint.
+    with_pos : (J,) bool
+        Joints written with position channels.
+    offsets, ends : (J, 3) float
+        OFFSETs and End Site offsets, file units.
+    translations : (F, J, 3) float
+        Local translations per frame, file units.
+    euler : (F, J, 3) float
+        Degrees per frame.
+    """
+    order_dfs, children = _depth_first(parents)
+    lines, columns = ["HIERARCHY"], []
+
+    def write(j, depth):
+        pad = "  " * depth
+        kind = "ROOT" if parents[j] < 0 else "JOINT"
+        o = offsets[j]
+        chans = (("Xposition Yposition Zposition " if with_pos[j] else "")
+                 + " ".join(f"{a}rotation" for a in orders[j]))
+        lines.extend([f"{pad}{kind} {names[j]}", f"{pad}{{",
+                      f"{pad}  OFFSET {o[0]:.6f} {o[1]:.6f} {o[2]:.6f}",
+                      f"{pad}  CHANNELS {6 if with_pos[j] else 3} {chans}"])
+        if with_pos[j]:
+            columns.append(translations[:, j])
+        columns.append(euler[:, j])
+        for c in children[j]:
+            write(c, depth + 1)
+        if not children[j]:
+            end = ends[j]
+            lines.extend([f"{pad}  End Site", f"{pad}  {{",
+                          f"{pad}    OFFSET {end[0]:.6f} {end[1]:.6f} {end[2]:.6f}",
+                          f"{pad}  }}"])
+        lines.append(f"{pad}}}")
+
+    for j in order_dfs:
+        if parents[j] < 0:
+            write(j, 0)
+    return lines, columns
 
 
 def write_bvh(data, path, clips=None):

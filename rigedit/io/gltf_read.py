@@ -150,10 +150,10 @@ class SkeletonMap:
         self.skin_to_joint = np.array([self.of_node[n] for n in skin_nodes], dtype=np.int64)
 
 
-def _build_skeleton(data, skin_index, parent):
-    g = data.gltf
-    skin = g.skins[skin_index]
-    nodes = g.nodes or []
+def _skin_joints(data, skin_index):
+    """The skin's joint node indices, checked: a non-empty list of distinct node indices."""
+    skin = data.gltf.skins[skin_index]
+    count = len(data.gltf.nodes or [])
     if not isinstance(skin.joints or [], list):
         raise RigFileError(data.path, f"skin {skin_index}: expected 'joints' to be a list of "
                                       f"node indices, got {skin.joints!r}")
@@ -161,19 +161,27 @@ def _build_skeleton(data, skin_index, parent):
     if not joints:
         raise RigFileError(data.path, f"skin {skin_index}: expected joints, got none")
     for n in joints:
-        if not isinstance(n, int) or not 0 <= n < len(nodes):
+        if not isinstance(n, int) or not 0 <= n < count:
             raise RigFileError(data.path, f"skin {skin_index}: expected joint node indices "
-                                          f"below {len(nodes)}, got {n!r}")
+                                          f"below {count}, got {n!r}")
     if len(set(joints)) != len(joints):
         raise RigFileError(data.path, f"skin {skin_index}: expected distinct joints, got a "
                                       "node listed twice")
-    local = {}
+    return joints
 
-    def mat(n):
-        if n not in local:
-            local[n] = _local_matrix(data, n)
-        return local[n]
 
+def _members(joints, parent, mat):
+    """The nodes that become joints, each one's parent among them, and the folded prefix.
+
+    Returns
+    -------
+    members : list[int]
+        The skin's joints, then the non-joint ancestors that cannot be folded (not a
+        similarity), which become joints of their own.
+    parent_of : dict[int, int or None]
+    prefix : dict[int, (4, 4) array or None]
+        The product of the folded non-joint ancestors between a member and its parent.
+    """
     members = list(joints)
     inside = set(joints)
     for n in joints:  # non-joint ancestors that cannot be folded become joints themselves
@@ -194,12 +202,14 @@ def _build_skeleton(data, skin_index, parent):
         for k in reversed(chain):
             pre = pre @ mat(k)
         prefix[n] = None if np.allclose(pre, np.eye(4), atol=1e-12, rtol=0) else pre
-    raw = [nodes[n].name if isinstance(nodes[n].name, str) and nodes[n].name.strip()
-           else f"joint_{n}" for n in members]
-    names = unique_names(raw)
-    name_of = dict(zip(members, names))
-    order = topological_order(names, [name_of.get(parent_of[n]) for n in members])
-    ordered = [members[i] for i in order]
+    return members, parent_of, prefix
+
+
+def _rest_trs(data, ordered, prefix, mat, name_of):
+    """Local rest translations, rotations and scales (lists of arrays) of the joints' nodes:
+    the file's own TRS where a node has one and nothing was folded into it, else decomposed
+    from the (prefixed) matrix, a sheared one refused."""
+    nodes = data.gltf.nodes
     t, r, s = [], [], []
     for n in ordered:
         m = mat(n) if prefix[n] is None else prefix[n] @ mat(n)
@@ -216,6 +226,27 @@ def _build_skeleton(data, skin_index, parent):
                 r[-1] = np.asarray(node.rotation, dtype=np.float64)
             s[-1] = np.asarray(node.scale if node.scale is not None else [1, 1, 1],
                                dtype=np.float64)
+    return t, r, s
+
+
+def _build_skeleton(data, skin_index, parent):
+    nodes = data.gltf.nodes or []
+    joints = _skin_joints(data, skin_index)
+    local = {}
+
+    def mat(n):
+        if n not in local:
+            local[n] = _local_matrix(data, n)
+        return local[n]
+
+    members, parent_of, prefix = _members(joints, parent, mat)
+    raw = [nodes[n].name if isinstance(nodes[n].name, str) and nodes[n].name.strip()
+           else f"joint_{n}" for n in members]
+    names = unique_names(raw)
+    name_of = dict(zip(members, names))
+    order = topological_order(names, [name_of.get(parent_of[n]) for n in members])
+    ordered = [members[i] for i in order]
+    t, r, s = _rest_trs(data, ordered, prefix, mat, name_of)
     smap = SkeletonMap(ordered, [prefix[n] for n in ordered], joints)
     parents = [-1 if parent_of[n] is None else smap.of_node[parent_of[n]] for n in ordered]
     deform = np.array([n in set(joints) and _own(nodes[n]).get("deform") is not False
