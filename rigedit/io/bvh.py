@@ -255,7 +255,7 @@ def read_bvh(path, scale=None):
 def load_bvh(path, scale=None):
     """Read a BVH file into a mesh-less :class:`~rigedit.rig.Rig` with one clip
     (:func:`read_bvh`, then ``Rig.from_data``); ``rig.meta`` and ``rig.notes`` say what was
-    decided."""
+    decided. Kept for the callers of old: new code reads the data and builds the rig."""
     return build_rig(read_bvh(path, scale=scale))
 
 

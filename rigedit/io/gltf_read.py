@@ -336,7 +336,8 @@ def read_gltf(path):
 
 def load_gltf(path):
     """Read a skinned glTF 2.0 file into a :class:`~rigedit.rig.Rig` (:func:`read_gltf`, then
-    ``Rig.from_data``)."""
+    ``Rig.from_data``). Kept for the callers of old: new code reads the data and builds the
+    rig."""
     return build_rig(read_gltf(path))
 
 

@@ -16,7 +16,7 @@ The protocol
 From step 2 to the end, SIGINT and SIGTERM are held and delivered afterwards, so an
 interrupted command leaves the new state in place rather than for the next load to finish.
 
-:func:`recover_interrupted_save` (run by ``load_rig_folder`` and at the start of every save)
+:func:`recover_interrupted_save` (run by ``read_rig_folder`` and at the start of every save)
 finishes what a killed save left: a staging folder with a journal is applied again, which is
 idempotent (a file already moved is no longer staged), so the folder loads as the new state;
 one without a journal is deleted, so the folder loads as the old state.
