@@ -18,7 +18,8 @@ __all__ = ["main", "parse_args"]
 def parse_args(argv=None, prog="rigedit-editor"):
     parser = argparse.ArgumentParser(prog=prog, description="rigedit, a rig editor")
     parser.add_argument("rig", nargs="?", help="rig folder or bundled name (default: quadruped)")
-    parser.add_argument("--screenshot", metavar="OUT.png", help="save a window screenshot and exit")
+    parser.add_argument("--screenshot", metavar="OUT.png",
+                        help="save a window screenshot and exit")
     parser.add_argument("--size", default="1440x900", help="window size WxH (default 1440x900)")
     return parser.parse_args(argv)
 
@@ -62,7 +63,8 @@ def main(argv=None, prog="rigedit-editor"):
         except (ValueError, OSError) as exc:
             print(f"{prog}: {exc}", file=sys.stderr)
             return 2
-    window = MainWindow(rig)
+    # Save / Discard / Cancel when closing with unsaved changes (not for a screenshot)
+    window = MainWindow(rig, confirm_close=not args.screenshot)
     w, h = (int(v) for v in args.size.lower().split("x"))
     window.resize(w, h)
     window.show()
@@ -84,7 +86,6 @@ def main(argv=None, prog="rigedit-editor"):
     from ..model import skinning_kernels
 
     QtCore.QTimer.singleShot(500, skinning_kernels.start_loading)
-    window.confirm_close = True  # Save / Discard / Cancel when closing with unsaved changes
     return app.exec_()
 
 

@@ -3,7 +3,8 @@
 bind (edit) mode, so the user can fix joints at once; when the result is NOT SURE the status
 bar says why and the first joint in doubt is selected.
 
-The work runs through :class:`~rigedit.ui.jobs.JobRunner` (progress bar with the stage's name, Cancel).
+The work runs through :class:`~rigedit.ui.jobs.JobRunner` (progress bar with the stage's name,
+Cancel).
 Bad input (a mesh that is not closed, a template file that is not a skeleton, a mesh with
 nothing like the template's limbs) shows through the window's error path and the open document
 stays as it was; so does a cancel.
@@ -205,15 +206,12 @@ class AutorigAction:
         ``replacing(action)`` (:meth:`FileActions.replacing
         <rigedit.ui.file_actions.FileActions.replacing>`): None when the user keeps the open
         document, else a check to call when the new one arrives.
-    set_mode : callable
-        ``set_mode("edit")``: the result opens in bind mode.
     """
 
-    def __init__(self, document, services, replacing, set_mode):
+    def __init__(self, document, services, replacing):
         self.document = document
         self.services = services
         self.replacing = replacing
-        self.set_mode = set_mode
         self.dialog = None
         self.relay = _StageRelay()
         self.relay.stage.connect(self._show_stage)
@@ -274,7 +272,7 @@ class AutorigAction:
         if not rig.name:
             rig.name = mesh.stem
         self.document.set_rig(rig, modified=True)
-        self.set_mode("edit")
+        self.document.set_mode("edit")   # the window follows the mode event
         doubtful = [n for n in getattr(getattr(rig, "autorig_report", None), "doubtful", [])
                     if n in rig.skeleton.index]
         if doubtful:   # the first joint in doubt, ready to drag (the status bar says why)

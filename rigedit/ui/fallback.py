@@ -2,13 +2,15 @@
 the UI tests' fixture. A four-legged creature of tubes around its bones, Y up, facing +Z."""
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from ..io.mesh import weld_vertices
 from ..io.skeleton_json import skeleton_from_heads
 from ..rig import Rig
 
-__all__ = ["demo_rig"]
+__all__ = ["default_rig", "demo_rig"]
 
 _JOINTS = [  # name, parent, head (x, y, z)
     ("root", None, (0.0, 0.0, 0.0)),
@@ -96,3 +98,22 @@ def demo_rig():
     # Tubes meet at joints: merge coincident vertices, as the mesh loader would on reading.
     vertices, faces = weld_vertices(np.vstack(verts), np.vstack(faces))
     return Rig(skeleton, vertices, faces, name="demo creature", up="y")
+
+
+def default_rig():
+    """The bundled quadruped, or the code-built creature when the assets are not installed.
+
+    Returns
+    -------
+    rig : Rig
+    note : str or None
+        Why the fallback was used.
+    """
+    import rigedit
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return rigedit.load_rig(), None
+    except (ValueError, OSError) as exc:
+        return demo_rig(), f"bundled quadruped not available ({exc}); showing a demo creature"

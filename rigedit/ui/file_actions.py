@@ -1,5 +1,6 @@
 """The File menu's work: open, save, export, weights. Reading and computing run in a worker
-(:class:`~rigedit.ui.jobs.JobRunner`); a bad file gives one message naming it and keeps the current rig.
+(:class:`~rigedit.ui.jobs.JobRunner`); a bad file gives one message naming it and keeps the
+current rig.
 """
 from __future__ import annotations
 

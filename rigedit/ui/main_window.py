@@ -20,8 +20,7 @@ safety             :mod:`.autosave`, :mod:`.errors_hook`, :mod:`.proxy_view` (bi
 """
 from __future__ import annotations
 
-import sys
-import warnings
+import functools
 
 from PyQt5 import QtCore, QtWidgets
 
@@ -32,10 +31,12 @@ from .autorig_dialog import AutorigAction
 from .autosave import Autosave, confirm_unsaved_changes
 from .brush_panel import BrushPanel
 from .edit_actions import EditActions
+from .fallback import default_rig
 from .file_actions import FileActions
 from .import_motion import ImportMotion
 from .jobs import JobRunner
 from .menus import build_menus
+from .messages import Messages
 from .panels import PANEL_PLAYBACK_MS, Panels  # noqa: F401 - PANEL_PLAYBACK_MS: old home
 from .proxy_view import ProxyView
 from .rebind import RestRebind
@@ -52,25 +53,14 @@ from .window_image import window_image
 __all__ = ["MainWindow", "default_rig"]
 
 
-def default_rig():
-    """The bundled quadruped, or the code-built creature when the assets are not installed.
-
-    Returns
-    -------
-    rig : Rig
-    note : str or None
-        Why the fallback was used.
-    """
-    import rigedit
-
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            return rigedit.load_rig(), None
-    except (ValueError, OSError) as exc:
-        from .fallback import demo_rig
-
-        return demo_rig(), f"bundled quadruped not available ({exc}); showing a demo creature"
+def _forward(method, part):
+    """A window method that calls ``method`` (a function of a part's class) on the window's
+    attribute ``part``, with its docstring: the window's API names stay where scripts and
+    tests look for them, the work stays in the part."""
+    @functools.wraps(method)
+    def call(self, *args, **kwargs):
+        return method(getattr(self, part), *args, **kwargs)
+    return call
 
 
 class MainWindow(QtWidgets.QMainWindow):
@@ -80,6 +70,9 @@ class MainWindow(QtWidgets.QMainWindow):
     ----------
     rig : Rig, optional
         The default character when omitted.
+    confirm_close : bool
+        Ask about unsaved changes on close and before another document replaces this one
+        (the app; scripts and tests driving the window do not want the question).
 
     Attributes
     ----------
@@ -109,7 +102,7 @@ class MainWindow(QtWidgets.QMainWindow):
         Keep the recovery entry on close (quitting on a signal); ask about unsaved changes.
     """
 
-    def __init__(self, rig=None, parent=None):
+    def __init__(self, rig=None, parent=None, confirm_close=False):
         super().__init__(parent)
         note = None
         if rig is None:
@@ -117,46 +110,47 @@ class MainWindow(QtWidgets.QMainWindow):
         self.setWindowTitle("rigedit")
         self.document = d = Document(rig)
         self.drag_settings = DragSettings()
-        self.last_error = self._last_dialog = None
         self.keep_recovery = False   # set when quitting on a signal: the entry must stay
-        self.confirm_close = False   # ask about unsaved changes on close (app.py sets it)
+        self.confirm_close = confirm_close
         self._closed = False
         sb = self.statusBar()
-        self.error_display = errors_hook.ErrorDisplay(sb, self)
+        self.messages = Messages(sb, self, lambda: self.autosave.crash_save())
+        self.error_display = self.messages.display
         self.jobs = JobRunner(sb, self.status, self.error, self.show_unexpected_error,
                               self.report_exception)
-        self.rebind = RestRebind(d, self.jobs.run, self.jobs.current, lambda: self.scene_view.refresh(),
-                                 self.status, lambda: self.scene_view.interacting,
-                                 lambda: self.edit.update())
-        self.scene_view = SceneView(self, d, self.drag_settings, self.rebind.move_joint, self.status,
-                              self.report_exception)
+        # the 3D view hands edit-mode rest moves to the re-bind, which refreshes the view
+        self.scene_view = view = SceneView(self, d, self.drag_settings,
+                                           lambda j, head: self.rebind.move_joint(j, head),
+                                           self.status, self.report_exception)
+        self.rebind = RestRebind(d, self.jobs.run, self.jobs.current, view.refresh, self.status,
+                                 lambda: view.interacting, lambda: self.edit.update())
         self.plotter = self.scene_view.plotter
         self.setCentralWidget(self.plotter)
         services = Services(self, self.status, self.error, self.report_exception,
-                            self.scene_view.request_render, self.jobs)
+                            view.request_render, self.jobs)
         self.edit = EditActions(self, d, self.rebind)
         self.jobs.changed.connect(self.edit.update)
-        self.view_actions = ViewActions(self, self.scene_view, d, self.status)
+        self.view_actions = ViewActions(self, view, d, self.status)
         sb.addPermanentWidget(self.view_actions.mode_label)
         self._build_docks()
         self.files = FileActions(d, services, lambda: self.confirm_close,
                                  lambda action: confirm_unsaved_changes(self, action=action),
                                  self.screenshot, self.close)
-        self.autorig = AutorigAction(d, services, self.files.replacing, self.set_mode)
-        self.reembed = ReembedAction(d, services, self.set_mode)
+        self.autorig = AutorigAction(d, services, self.files.replacing)
+        self.reembed = ReembedAction(d, services)
         self.motion_import = ImportMotion(d, services, self.timeline.clip_manager.add_clip)
-        self.recorder = RecordVideo(d, self.scene_view, services)
+        self.recorder = RecordVideo(d, view, services)
         d.subscribe(self._on_document)   # after the timeline's (it samples the clip first)
         self._on_document("rig")
         # parts that draw into (or listen to) the scene come once it is built
-        self.weight_brush = WeightBrush(d, self.scene_view, BrushPanel(), self.panels.info_panel,
+        self.weight_brush = WeightBrush(d, view, BrushPanel(), self.panels.info_panel,
                                         services, self.set_weights_view)
-        self.weight_tools = WeightTools(self, d, self.scene_view, self.files.recompute_weights,
+        self.weight_tools = WeightTools(self, d, view, self.files.recompute_weights,
                                         self.panels.joint_panel)
         # a big mesh is drawn as its decimated proxy while it moves (issue 12)
-        self.proxy_view = ProxyView(lambda: self.scene_view.scene, d, sb, self.scene_view.request_render,
-                                    lambda: self.scene_view.weights_view)
-        self.autosave = Autosave(self, d, self.status, lambda: self.scene_view.interacting)
+        self.proxy_view = ProxyView(lambda: view.scene, d, sb, view.request_render,
+                                    lambda: view.weights_view)
+        self.autosave = Autosave(self, d, self.status, lambda: view.interacting)
         self._build_menus()
         errors_hook.install(self)
         self.resize(1440, 900)
@@ -204,6 +198,8 @@ class MainWindow(QtWidgets.QMainWindow):
             view.show_rest_change()
         elif event == "selection":
             view.show_selection(info.get("joint"))
+        elif event == "mode":
+            self.view_actions.mode_changed()
         self.panels.on_document(event, **info)
         if event in ("rig", "undo"):
             self.edit.update()
@@ -244,59 +240,24 @@ class MainWindow(QtWidgets.QMainWindow):
     def chain_length(self, n):
         self.drag_settings.chain_length = int(n)
 
-    def shown_pose(self):
-        """The pose on screen: the document's in pose mode, the rest pose in edit mode."""
-        return self.scene_view.shown_pose()
-
     def show_pose(self, pose):
         """Show ``pose`` (a Pose or (J, 10) snapshot) as the current pose, without an undo
         step (for playback and scrubbing); the view and gizmos follow."""
         self.document.set_pose(pose)
 
-    def request_render(self):
-        """Ask Qt to repaint the view once; inside a gizmo drag VTK renders by itself."""
-        self.scene_view.request_render()
-
-    def view(self, name):
-        """Camera preset: "front", "side", "top", "back" or "reset" (three-quarter view)."""
-        self.scene_view.view(name)
-
-    # ================================================================== options, by name
-    def undo(self):
-        """Edit > Undo (:meth:`EditActions.undo <rigedit.ui.edit_actions.EditActions.undo>`)."""
-        return self.edit.undo()
-
-    def set_mode(self, mode):
-        """"pose" (drag poses the character) or "edit" (drag moves rest positions)."""
-        self.view_actions.set_mode(mode)
-
-    def set_axis(self, axis):
-        """Constrain drags to model axis 0, 1 or 2 (X, Y, Z), or free (None)."""
-        self.view_actions.set_axis(axis)
-
-    def display_mode(self):
-        return self.view_actions.display_mode()
-
-    def set_display_mode(self, mode):
-        """"solid", "translucent" (with wireframe) or "wireframe"."""
-        self.view_actions.set_display_mode(mode)
-
-    def set_skeleton_visible(self, on):
-        self.view_actions.set_skeleton_visible(on)
-
-    def set_gizmos_visible(self, on):
-        self.view_actions.set_gizmos_visible(on)
-
-    def set_weights_view(self, on):
-        """Weight paint view: colour the mesh by the selected joint's influence."""
-        self.view_actions.set_weights_view(on)
-
-    def run_job(self, label, fn, on_done, on_cancel=None):
-        """:meth:`JobRunner.run <rigedit.ui.jobs.JobRunner.run>`."""
-        return self.jobs.run(label, fn, on_done, on_cancel)
-
-    def cancel_job(self):
-        self.jobs.cancel()
+    shown_pose = _forward(SceneView.shown_pose, "scene_view")
+    request_render = _forward(SceneView.request_render, "scene_view")
+    view = _forward(SceneView.view, "scene_view")
+    undo = _forward(EditActions.undo, "edit")
+    set_mode = _forward(ViewActions.set_mode, "view_actions")
+    set_axis = _forward(ViewActions.set_axis, "view_actions")
+    display_mode = _forward(ViewActions.display_mode, "view_actions")
+    set_display_mode = _forward(ViewActions.set_display_mode, "view_actions")
+    set_skeleton_visible = _forward(ViewActions.set_skeleton_visible, "view_actions")
+    set_gizmos_visible = _forward(ViewActions.set_gizmos_visible, "view_actions")
+    set_weights_view = _forward(ViewActions.set_weights_view, "view_actions")
+    run_job = _forward(JobRunner.run, "jobs")
+    cancel_job = _forward(JobRunner.cancel, "jobs")
 
     def record_video(self, path, fps=30, duration=None, size=(1280, 720), **options):
         """Record the current clip to ``path`` (MP4 or GIF) off-screen, as File > Export video
@@ -304,31 +265,13 @@ class MainWindow(QtWidgets.QMainWindow):
         return self.recorder.record(path, fps=fps, duration=duration, size=size, **options)
 
     # ================================================================== messages
-    def status(self, text, timeout=0):
-        self.statusBar().showMessage(text, timeout)
-
-    def report_exception(self, what=None):
-        """Log and show the exception being handled (see :mod:`.errors_hook`); for code that
-        must not let it propagate (VTK observers, job callbacks)."""
-        errors_hook.report(what, sys.exc_info())
-
-    def show_unexpected_error(self, what, summary):
-        """Called by :mod:`.errors_hook` for a bug (not bad input): the document is written
-        for recovery first, as the state after a bug may not be trustworthy; then
-        :class:`~.errors_hook.ErrorDisplay` shows it."""
-        saved = self.autosave.crash_save()
-        self.last_error = f"{what} failed: {summary}" if what else summary
-        self.error_display.show(what, summary, saved)
-
-    def error(self, title, message):
-        """Show one clear message: a dialog (not blocking) and the status bar."""
-        self.last_error = message
-        self.status(f"Error: {message}")
-        box = QtWidgets.QMessageBox(QtWidgets.QMessageBox.Warning, title, message,
-                                    QtWidgets.QMessageBox.Ok, self)
-        box.setAttribute(QtCore.Qt.WA_DeleteOnClose)
-        box.open()
-        self._last_dialog = box
+    status = _forward(Messages.status, "messages")
+    error = _forward(Messages.error, "messages")
+    report_exception = _forward(Messages.report_exception, "messages")
+    show_unexpected_error = _forward(Messages.show_unexpected_error, "messages")
+    last_error = property(lambda self: self.messages.last_error,
+                          doc="The last error message shown.")
+    _last_dialog = property(lambda self: self.messages.last_dialog)
 
     # ================================================================== screenshot, close
     def screenshot(self, path=None):

@@ -4,7 +4,8 @@ bind mode are pinned (hints) and the embedding runs again for the others.
 The joints moved are those whose rest position left where the auto-rig (or the last re-embed)
 put them (``rig.autorig_report.embedded``; a rest move keeps the other joints' positions), and
 those pinned by the last re-embed stay pinned where they are now. The work runs off the UI
-thread through :class:`~rigedit.ui.jobs.JobRunner` (progress bar, Cancel), as File > Auto-rig mesh does:
+thread through :class:`~rigedit.ui.jobs.JobRunner` (progress bar, Cancel), as File > Auto-rig
+mesh does:
 :func:`rigedit.autorig` on the character's own mesh (already standing +Y up, facing +Z) with
 the same template, weights method and clips. The result replaces the character as a new
 auto-rig does (name, folder and texture kept; the undo history starts again: the skeleton,
@@ -68,16 +69,13 @@ class ReembedAction:
     ----------
     document : Document
     services : Services
-    set_mode : callable
-        ``set_mode("edit")``: the result opens in bind mode.
     """
 
     LABEL = "Re-embedding"
 
-    def __init__(self, document, services, set_mode):
+    def __init__(self, document, services):
         self.document = document
         self.services = services
-        self.set_mode = set_mode
 
     def actions(self):
         """name -> QAction for :func:`.menus.build_menus`."""
@@ -132,7 +130,7 @@ class ReembedAction:
             new.surface = rig.surface   # same vertices in the same order: the texture holds
         new.autorig_report.source = rig.autorig_report.source
         doc.set_rig(new, modified=True)
-        self.set_mode("edit")
+        self.document.set_mode("edit")   # the window follows the mode event
         shown = ", ".join(pinned[:6]) + (f" and {len(pinned) - 6} more" if len(pinned) > 6
                                          else "")
         status(f"Re-embedded around {shown}; the other joints placed again "

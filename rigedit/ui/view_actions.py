@@ -143,13 +143,18 @@ class ViewActions:
         self.view.set_axis(axis)
 
     def set_mode(self, mode):
-        """"pose" (drag poses the character) or "edit" (drag moves rest positions)."""
+        """"pose" (drag poses the character) or "edit" (drag moves rest positions); the view
+        follows the document's ``mode`` event (:meth:`mode_changed`)."""
         if mode not in ("pose", "edit"):
             raise ValueError(f"expected mode 'pose' or 'edit', got {mode!r}")
         (self.pose_mode_action if mode == "pose" else self.edit_mode_action).setChecked(True)
-        if mode == self.document.mode:
-            return
-        self.document.mode = mode
+        self.document.set_mode(mode)
+
+    def mode_changed(self):
+        """The document's mode changed (here or from a script): the tool bar, the view (the
+        rest pose in edit mode) and the mode label follow."""
+        mode = self.document.mode
+        (self.pose_mode_action if mode == "pose" else self.edit_mode_action).setChecked(True)
         self.view.refresh_pose()
         self.show_mode()
         self.status("Edit mode: drag a joint to move its rest position; the skin is re-bound "

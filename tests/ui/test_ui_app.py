@@ -39,3 +39,20 @@ def test_app_bad_rig_exits_with_message(tmp_path):
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2
     assert "missing" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_the_editor_entry_point_is_the_packages_main(tmp_path):
+    # setup.cfg installs rigedit-editor = rigedit.ui.app:main; app.py is a thin wrapper of it
+    import configparser
+
+    cfg = configparser.ConfigParser()
+    cfg.read(ROOT / "setup.cfg")
+    scripts = dict(line.split(" = ") for line in
+                   cfg["options.entry_points"]["gui_scripts"].strip().splitlines())
+    assert scripts == {"rigedit-editor": "rigedit.ui.app:main"}
+    proc = subprocess.run([sys.executable, "-m", "rigedit.ui.app", "--screenshot",
+                           str(tmp_path / "x.png"), str(tmp_path / "missing")],
+                          capture_output=True, text=True, timeout=60, cwd=ROOT)
+    assert proc.returncode == 2
+    assert "rigedit-editor: " in proc.stderr and "missing" in proc.stderr
+    assert "Traceback" not in proc.stderr
