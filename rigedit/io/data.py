@@ -12,6 +12,8 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
+from rigedit.model.morph import MorphTargets
+
 __all__ = ["RigData", "RigMeta", "WeightsComputedWarning", "as_rig_data", "build_rig",
            "register_rig_builder"]
 
@@ -84,6 +86,9 @@ class RigData:
     up : {"y", "z"}
         The vertical axis.
     meta : RigMeta
+    morphs : rigedit.model.morph.MorphTargets or None
+        Morph targets (glTF morph targets, FBX blend shapes) of ``vertices``, in the same
+        vertex order; None when the file has none.
     """
 
     skeleton: Any
@@ -96,10 +101,11 @@ class RigData:
     name: str = "rig"
     up: str = "y"
     meta: RigMeta = field(default_factory=RigMeta)
+    morphs: Optional[MorphTargets] = None
 
     def __post_init__(self):
-        self.vertices = np.asarray(self.vertices, dtype=np.float64).reshape(-1, 3)
-        self.faces = np.asarray(self.faces, dtype=np.int64).reshape(-1, 3)
+        self.vertices = np.asarray(self.vertices, dtype=np.float64)
+        self.faces = np.asarray(self.faces, dtype=np.int64)
 
 
 def as_rig_data(rig):
