@@ -89,7 +89,7 @@ class ReembedAction:
         there is nothing to do or another job runs."""
         doc, status, job = self.document, self.services.status, self.services.jobs.job
         rig = doc.rig
-        report = getattr(rig, "autorig_report", None)
+        report = rig.meta.autorig_report
         try:
             hints = moved_joints(doc.skeleton, report)
         except ValueError as exc:
