@@ -12,6 +12,8 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
+from rigedit.model.morph import MorphTargets
+
 __all__ = ["RigData", "RigMeta", "WeightsComputedWarning", "as_rig_data", "build_rig",
            "register_rig_builder"]
 

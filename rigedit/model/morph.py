@@ -1,0 +1,186 @@
+"""Morph targets (glTF morph targets, FBX blend shapes): per-vertex displacements in bind space.
+
+A morphed rest point is ``rest + sum_m w_m * deltas[m]`` (glTF 2.0, "Morph Targets"); the
+skinning pass then deforms that point as it would the rest point. Only the targets with a
+non-zero weight cost anything: with every weight 0, :meth:`MorphTargets.apply` returns None
+and the caller skins the plain rest points.
+
+Each target keeps, next to its dense (V, 3) deltas, the rows it actually moves (a face shape
+moves a few hundred of a body's vertices), so applying a target costs its moved rows only.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+
+__all__ = ["MorphTargets"]
+
+
+@dataclass(eq=False)
+class MorphTargets:
+    """The morph targets of one mesh.
+
+    Attributes
+    ----------
+    names : tuple of str, (M,)
+        Unique target names.
+    deltas : (M, V, 3) float32
+        Position displacements in bind (model) space.
+    normal_deltas : (M, V, 3) float32 or None
+        Normal displacements (added to the rest normals, renormalised by the skinning pass).
+    default_weights : (M,) float64 or None
+        The weights when nothing sets them (glTF ``mesh.weights``); zeros if None.
+    """
+
+    names: tuple
+    deltas: np.ndarray
+    normal_deltas: Optional[np.ndarray] = None
+    default_weights: Optional[np.ndarray] = None
+    # per target: the vertex rows it moves (int64) and their deltas, built once
+    _rows: list = field(default_factory=list, init=False, repr=False)
+    _sparse: list = field(default_factory=list, init=False, repr=False)
+    _sparse_n: list = field(default_factory=list, init=False, repr=False)
+
+    def __post_init__(self):
+        self.names = tuple(str(n) for n in self.names)
+        if len(set(self.names)) != len(self.names):
+            raise ValueError(f"morph target names are not unique: {self.names}")
+        self.deltas = np.ascontiguousarray(self.deltas, dtype=np.float32)
+        if self.deltas.ndim != 3 or self.deltas.shape[2] != 3 \
+                or self.deltas.shape[0] != len(self.names):
+            raise ValueError(f"morph deltas must be ({len(self.names)}, V, 3), "
+                             f"not {self.deltas.shape}")
+        if not np.isfinite(self.deltas).all():
+            raise ValueError("morph deltas are not all finite")
+        if self.normal_deltas is not None:
+            self.normal_deltas = np.ascontiguousarray(self.normal_deltas, dtype=np.float32)
+            if self.normal_deltas.shape != self.deltas.shape:
+                raise ValueError(f"morph normal deltas must be {self.deltas.shape}, "
+                                 f"not {self.normal_deltas.shape}")
+            if not np.isfinite(self.normal_deltas).all():
+                raise ValueError("morph normal deltas are not all finite")
+        if self.default_weights is None:
+            self.default_weights = np.zeros(len(self.names))
+        self.default_weights = np.asarray(self.default_weights, dtype=np.float64).reshape(-1)
+        if self.default_weights.shape != (len(self.names),):
+            raise ValueError(f"morph default weights must be ({len(self.names)},), "
+                             f"not {self.default_weights.shape}")
+        self._index_rows()
+
+    def _index_rows(self):
+        """Per target the rows it moves (position or normal), and their deltas."""
+        self._rows, self._sparse, self._sparse_n = [], [], []
+        for m in range(len(self.names)):
+            moved = np.any(self.deltas[m] != 0, axis=1)
+            if self.normal_deltas is not None:
+                moved |= np.any(self.normal_deltas[m] != 0, axis=1)
+            rows = np.flatnonzero(moved)
+            self._rows.append(rows)
+            self._sparse.append(np.ascontiguousarray(self.deltas[m][rows]))
+            self._sparse_n.append(None if self.normal_deltas is None else
+                                  np.ascontiguousarray(self.normal_deltas[m][rows]))
+
+    # ------------------------------------------------------------------ facts
+    @property
+    def count(self) -> int:
+        """M, the number of targets."""
+        return len(self.names)
+
+    @property
+    def n_vertices(self) -> int:
+        """V, the vertices each target displaces."""
+        return int(self.deltas.shape[1])
+
+    def index(self, name) -> int:
+        """The position of target ``name`` in :attr:`names` (KeyError if none)."""
+        try:
+            return self.names.index(name)
+        except ValueError:
+            raise KeyError(name) from None
+
+    def moved_rows(self, m) -> np.ndarray:
+        """(n,) int64: the vertices target ``m`` moves."""
+        return self._rows[m]
+
+    def weights_array(self, weights=None) -> np.ndarray:
+        """(M,) float64 weights from ``weights``: None (the defaults), a sequence of M
+        numbers, or a mapping name -> weight (names not given keep their default; names
+        that are not targets are ignored, so a clip made for another rig does no harm)."""
+        if weights is None:
+            return self.default_weights.copy()
+        if isinstance(weights, dict):
+            out = self.default_weights.copy()
+            for name, w in weights.items():
+                if name in self.names:
+                    out[self.names.index(name)] = float(w)
+            return out
+        out = np.asarray(weights, dtype=np.float64).reshape(-1)
+        if out.shape != (self.count,):
+            raise ValueError(f"expected {self.count} morph weights, got {out.shape}")
+        return out
+
+    def active(self, weights) -> np.ndarray:
+        """(A,) int64: the targets whose weight is not 0 (and that move something)."""
+        w = self.weights_array(weights)
+        return np.array([m for m in np.flatnonzero(w != 0) if len(self._rows[m])],
+                        dtype=np.int64)
+
+    # ------------------------------------------------------------------ apply
+    def apply(self, weights, out=None):
+        """The displacement sum ``sum_m w_m * deltas[m]``.
+
+        Parameters
+        ----------
+        weights : None, (M,) sequence or dict name -> float
+            See :meth:`weights_array`.
+        out : (V, 3) float32, optional
+            Buffer written in place (zeroed first) and returned.
+
+        Returns
+        -------
+        (V, 3) float32 or None
+            None when no target is active (all weights 0): no time is spent and the caller
+            uses the rest points as they are.
+        """
+        return self._apply(weights, out, self._sparse)
+
+    def apply_normals(self, weights, out=None):
+        """The normal displacement sum, as :meth:`apply` (None also when the targets have no
+        normal deltas)."""
+        if self.normal_deltas is None:
+            return None
+        return self._apply(weights, out, self._sparse_n)
+
+    def _apply(self, weights, out, sparse):
+        w = self.weights_array(weights)
+        act = [m for m in np.flatnonzero(w != 0) if len(self._rows[m])]
+        if not act:
+            return None
+        if out is None:
+            out = np.zeros((self.n_vertices, 3), dtype=np.float32)
+        else:
+            out[...] = 0.0
+        for m in act:
+            # rows are unique within one target, so the fancy-index add is exact
+            out[self._rows[m]] += np.float32(w[m]) * sparse[m]
+        return out
+
+    def morphed(self, rest, weights, out=None):
+        """(V, 3) float32 ``rest + apply(weights)``; ``rest`` itself (not a copy) when no
+        target is active."""
+        disp = self.apply(weights)
+        if disp is None:
+            return rest
+        if out is None:
+            out = np.empty((self.n_vertices, 3), dtype=np.float32)
+        np.add(rest, disp, out=out, casting="unsafe")
+        return out
+
+    def subset(self, vertex_rows):
+        """The targets restricted to the vertices ``vertex_rows`` (a mesh split or merged)."""
+        rows = np.asarray(vertex_rows, dtype=np.int64)
+        return MorphTargets(self.names, self.deltas[:, rows],
+                            None if self.normal_deltas is None else self.normal_deltas[:, rows],
+                            self.default_weights.copy())
