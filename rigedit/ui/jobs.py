@@ -1,7 +1,8 @@
 """Long work off the UI thread: a QThread running a pure function with progress and cancel.
 
-The function never touches Qt widgets or VTK; it reports progress through ``report(fraction)``,
-which raises :class:`Cancelled` once the user pressed Cancel. Results come back on the main
+The function never touches Qt widgets or VTK; it reports progress through
+``report(fraction, stage=None)`` (:mod:`rigedit.progress`'s protocol), which raises
+:class:`~rigedit.progress.Cancelled` once the user pressed Cancel. Results come back on the main
 thread through Qt signals, where the caller applies them (VTK calls stay on the main thread).
 """
 from __future__ import annotations
@@ -11,12 +12,9 @@ import threading
 from PyQt5 import QtCore, QtWidgets
 
 from ..binding.weights import compute_weights, default_method
+from ..progress import Cancelled  # the one way to stop a job (rigedit.progress)
 
 __all__ = ["Cancelled", "Job", "JobRunner", "weights_in_chunks"]
-
-
-class Cancelled(Exception):
-    """The user cancelled the job."""
 
 
 class Job(QtCore.QThread):
@@ -25,6 +23,7 @@ class Job(QtCore.QThread):
     Signals
     -------
     progress(int)      percent done, 0-100 (-1 when the job cannot tell)
+    stage(str)         the name of the step now running, when it changes
     succeeded(object)  the function's result
     failed(str)        one-line error message (ValueError and RigFileError keep their text);
                        ``unexpected`` is then true when it was a bug, not bad input
@@ -32,6 +31,7 @@ class Job(QtCore.QThread):
     """
 
     progress = QtCore.pyqtSignal(int)
+    stage = QtCore.pyqtSignal(str)
     succeeded = QtCore.pyqtSignal(object)
     failed = QtCore.pyqtSignal(str)
     cancelled = QtCore.pyqtSignal()
@@ -41,6 +41,7 @@ class Job(QtCore.QThread):
         self.label = label
         self.fn = fn
         self._cancel = threading.Event()
+        self._stage = None
         self.unexpected = False
 
     def cancel(self):
@@ -50,10 +51,15 @@ class Job(QtCore.QThread):
     def is_cancelled(self):
         return self._cancel.is_set()
 
-    def report(self, fraction):
+    def report(self, fraction, stage=None):
+        """The job's progress callable: ``fraction`` done (None: cannot tell) in step
+        ``stage``; raises :class:`Cancelled` after :meth:`cancel`."""
         if self._cancel.is_set():
             raise Cancelled()
         self.progress.emit(-1 if fraction is None else int(round(100 * fraction)))
+        if stage and stage != self._stage:
+            self._stage = stage
+            self.stage.emit(str(stage))
 
     def run(self):
         try:
@@ -123,15 +129,11 @@ class JobRunner(QtCore.QObject):
         """The job running now, or None."""
         return self.job
 
-    def set_stage(self, label, stage):
-        """Name the stage of the job ``label`` on the progress bar (when it still runs)."""
-        if self.job is not None and self.job.label == label:
-            self.progress.setFormat(f"{label}: {stage} %p%")
-
-    def run(self, label, fn, on_done, on_cancel=None):
+    def run(self, label, fn, on_done, on_cancel=None, show_stage=False):
         """Run ``fn(report)`` off the UI thread with a progress bar and a Cancel button;
-        ``on_done(result)`` runs on the main thread. Returns the :class:`Job`, or None (with
-        a message) when another job runs."""
+        ``on_done(result)`` runs on the main thread (``on_cancel()`` after a cancel or a
+        failure). With ``show_stage`` the bar names the step ``report`` was last given.
+        Returns the :class:`Job`, or None (with a message) when another job runs."""
         if self.job is not None:
             self.error("Busy", f"busy with '{self.job.label}': wait for it to finish, or "
                                f"cancel it, then try '{label}' again")
@@ -140,6 +142,8 @@ class JobRunner(QtCore.QObject):
         self.job = job
         self._show(label)
         job.progress.connect(self._progress)
+        if show_stage:
+            job.stage.connect(lambda stage: self._show_stage(job, stage))
         job.succeeded.connect(lambda result: self._succeeded(job, on_done, result))
         job.failed.connect(lambda msg: self._failed(job, on_cancel, msg))
         job.cancelled.connect(lambda: self._cancelled(job, on_cancel))
@@ -160,6 +164,10 @@ class JobRunner(QtCore.QObject):
         self.progress.setFormat(f"{label}: %p%")
         self.progress.setVisible(True)
         self.cancel_button.setVisible(True)
+
+    def _show_stage(self, job, stage):
+        if job is self.job:
+            self.progress.setFormat(f"{job.label}: {stage} %p%")
 
     def _progress(self, p):
         if p < 0:

@@ -37,6 +37,6 @@ class Services:
     request_render: Callable
     jobs: object
 
-    def run_job(self, label, fn, on_done, on_cancel=None):
+    def run_job(self, label, fn, on_done, on_cancel=None, show_stage=False):
         """:meth:`JobRunner.run <rigedit.ui.jobs.JobRunner.run>`."""
-        return self.jobs.run(label, fn, on_done, on_cancel)
+        return self.jobs.run(label, fn, on_done, on_cancel, show_stage)

@@ -133,3 +133,51 @@ def test_rebind_after_an_edit_mode_drag_can_be_cancelled(demo_window, qtbot, slo
     np.testing.assert_array_equal(window.scene.mesh.points, points0)
     assert len(doc.undo_stack) == 0 and window.mode == "edit"
     assert "cancelled" in window.statusBar().currentMessage()
+
+
+def test_job_runner_alone_bar_stage_cancel_and_one_job_at_a_time(qtbot):
+    # JobRunner is a part of its own: a status bar and four callables are all it takes
+    from PyQt5 import QtWidgets
+
+    from rigedit.progress import Cancelled
+    from rigedit.ui.jobs import JobRunner
+
+    window = QtWidgets.QMainWindow()
+    qtbot.addWidget(window)
+    said, errors = [], []
+    runner = JobRunner(window.statusBar(), said.append, lambda t, m: errors.append((t, m)),
+                       lambda what, summary: errors.append((what, summary)),
+                       lambda what: errors.append(what))
+    changes = []
+    runner.changed.connect(lambda: changes.append(runner.job))
+    formats, done = [], []
+
+    def work(report):
+        for stage in ("read", "read", "solve"):
+            report(0.5, stage)
+            time.sleep(0.05)
+        return 42
+
+    job = runner.run("Working", work, done.append, show_stage=True)
+    job.stage.connect(lambda _: formats.append(runner.progress.format()))
+    assert runner.job is job and runner.progress.isVisibleTo(window)
+    assert runner.run("Other", work, done.append) is None   # one job at a time
+    assert errors and errors[0][0] == "Busy"
+    qtbot.waitUntil(lambda: done == [42], timeout=10000)
+    assert runner.job is None and not runner.progress.isVisibleTo(window)
+    assert "Working: solve %p%" in formats
+    assert changes[0] is job and changes[-1] is None   # started, then ended
+
+    def endless(report):
+        while True:
+            report(None)   # raises Cancelled once cancelled
+            time.sleep(0.01)
+
+    cancelled = []
+    runner.run("Looping", endless, done.append, on_cancel=lambda: cancelled.append(1))
+    runner.cancel()
+    qtbot.waitUntil(lambda: cancelled == [1], timeout=10000)
+    assert said[-1] == "Looping: cancelled" and done == [42]
+    from rigedit.ui import jobs
+
+    assert jobs.Cancelled is Cancelled   # one cancellation exception (rigedit.progress)
