@@ -13,6 +13,7 @@ from pathlib import Path
 from PyQt5 import QtCore, QtWidgets
 
 from ..errors import RigFileError
+from ..progress import Cancelled
 from ..render.camera import camera_state
 from ..render.recorder import RecordingCancelled, record_clip
 from .menus import make_action
@@ -75,11 +76,11 @@ def record_video(document, view, status, path, fps=30, duration=None, size=(1280
         dialog.setMinimumDuration(0)
         dialog.setValue(0)
 
-        def callback(done, total_):
-            dialog.setMaximum(total_)
-            dialog.setValue(done)
-            QtWidgets.QApplication.processEvents()
-            return not dialog.wasCanceled()
+        def callback(fraction, stage=None):   # rigedit.progress's protocol
+            dialog.setValue(int(round(fraction * total)))
+            QtWidgets.QApplication.processEvents()   # the dialog repaints, Cancel works
+            if dialog.wasCanceled():
+                raise Cancelled()
     options.setdefault("skinning", view.scene.skinning)  # as the view shows it (LBS/DQS)
     try:
         n = record_clip(doc.rig, clip_obj, path, fps=fps, duration=duration, size=size,
