@@ -51,10 +51,15 @@ class Rig:
     meta : rigedit.io.data.RigMeta, optional
         Where the rig came from and what its reader decided (units, rotation orders, clip
         files, notes); kept as ``rig.meta``. A new, empty one when omitted.
+    morphs : rigedit.model.morph.MorphTargets, optional
+        Morph targets of ``vertices`` (``rig.morphs``), applied by the binding before
+        skinning with the weights of ``binding.set_morph_weights`` (:meth:`skin` takes them
+        per call).
     """
 
     def __init__(self, skeleton, vertices, faces, indices=None, weights=None, clips=None,
-                 name="rig", up="y", weights_method=None, path=None, surface=None, meta=None):
+                 name="rig", up="y", weights_method=None, path=None, surface=None, meta=None,
+                 morphs=None):
         self.skeleton = skeleton
         self.vertices = np.asarray(vertices, dtype=np.float64)
         self.faces = np.asarray(faces, dtype=np.int64)
@@ -64,6 +69,7 @@ class Rig:
         self.path = path
         self.meta = RigMeta(source=path) if meta is None else meta
         self.surface = surface
+        self.morphs = morphs
         self.weights_computed = indices is None
         self.weights_method = weights_method or default_method(self.faces)
         if indices is None:
@@ -91,7 +97,7 @@ class Rig:
                                                faces=data.faces)
         rig = cls(data.skeleton, data.vertices, data.faces, indices, weights, data.clips,
                   name=data.name, up=data.up, weights_method=method, path=data.meta.source,
-                  surface=data.surface, meta=data.meta)
+                  surface=data.surface, meta=data.meta, morphs=data.morphs)
         rig.weights_computed = data.indices is None
         return rig
 
@@ -101,7 +107,7 @@ class Rig:
         ``binding.weights``: (V, K), rows summing to 1)."""
         return RigData(self.skeleton, self.vertices, self.faces, self.binding.indices,
                        self.binding.weights, self.clips, surface=self.surface, name=self.name,
-                       up=self.up, meta=self.meta)
+                       up=self.up, meta=self.meta, morphs=self.morphs)
 
     # the older spellings of three fields of ``meta`` (rig attributes before ``meta`` existed)
     notes = _InMeta("notes", "What a reader decided where its format was silent "
@@ -113,8 +119,12 @@ class Rig:
 
     # ------------------------------------------------------------------ binding
     def bind(self, indices, weights):
-        """Replace the skin influences, (V, K) each."""
-        self.binding = SkinBinding(self.vertices, indices, weights, len(self.skeleton))
+        """Replace the skin influences, (V, K) each (the morph weights in effect are kept)."""
+        old = getattr(self, "binding", None)
+        self.binding = SkinBinding(self.vertices, indices, weights, len(self.skeleton),
+                                   morphs=self.morphs)
+        if old is not None and self.morphs is not None:
+            self.binding.set_morph_weights(old.morph_weights)
 
     @property
     def weights(self):
@@ -134,16 +144,26 @@ class Rig:
         """(J, 4, 4) model-space joint matrices of ``pose``."""
         return local_to_model(self.skeleton, pose)
 
-    def skin(self, pose, out=None, method="lbs"):
+    def skin(self, pose, out=None, method="lbs", morph_weights=None):
         """(V, 3) skinned vertex positions of ``pose`` (a new float64 array unless ``out``);
         ``method`` is ``"lbs"`` (linear blend) or ``"dqs"`` (dual quaternions, see
-        :mod:`rigedit.model.dqs`)."""
+        :mod:`rigedit.model.dqs`).
+
+        ``morph_weights`` (None: the targets' default weights; (M,) numbers or ``{name:
+        weight}``, a clip's :meth:`~rigedit.animation.clip.Clip.sample_morphs`) morph the rest
+        before skinning, for this call only: the binding's weights (the editor's) are put
+        back after."""
         palette = skinning_matrices(self.skeleton, self.joint_matrices(pose))
-        res = self.binding.skin(palette, method=method)
-        if out is None:
-            return res.astype(np.float64)
-        out[:] = res
-        return out
+        before = self.binding.morph_weights
+        self.binding.set_morph_weights(morph_weights)
+        try:
+            res = self.binding.skin(palette, method=method)
+            if out is None:
+                return res.astype(np.float64)
+            out[:] = res
+            return out
+        finally:
+            self.binding.set_morph_weights(before)
 
     def bounds(self):
         """(2, 3) min and max corner of the rest mesh; of the joints and bone tails at bind

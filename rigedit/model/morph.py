@@ -15,7 +15,7 @@ from typing import Optional
 
 import numpy as np
 
-__all__ = ["MorphTargets"]
+__all__ = ["MorphTargets", "MorphedRest"]
 
 
 @dataclass(eq=False)
@@ -104,6 +104,11 @@ class MorphTargets:
         """(n,) int64: the vertices target ``m`` moves."""
         return self._rows[m]
 
+    def sparse_target(self, m):
+        """Target ``m`` as the rows it moves: ``rows`` (n,) int64, position deltas (n, 3)
+        float32 and normal deltas (n, 3) float32 or None."""
+        return self._rows[m], self._sparse[m], self._sparse_n[m]
+
     def weights_array(self, weights=None) -> np.ndarray:
         """(M,) float64 weights from ``weights``: None (the defaults), a sequence of M
         numbers, or a mapping name -> weight (names not given keep their default; names
@@ -184,3 +189,77 @@ class MorphTargets:
         return MorphTargets(self.names, self.deltas[:, rows],
                             None if self.normal_deltas is None else self.normal_deltas[:, rows],
                             self.default_weights.copy())
+
+
+class MorphedRest:
+    """The rest points (and normals) a skinning pass reads, with the current weights' morphs.
+
+    Kept by :class:`rigedit.model.skinning.SkinBinding`. With no active target the plain
+    rest arrays are handed out as they are (no copy, no time). Otherwise one float32 buffer
+    per array holds ``rest + sum w * delta``; a change of weights rewrites only the rows the
+    previous and the new active targets move, so a face shape animated on a large body costs
+    its own few hundred rows per frame, not the body.
+
+    Parameters
+    ----------
+    morphs : MorphTargets
+    rest : (V, 3) float32
+        The binding's rest points (read, never written).
+    """
+
+    def __init__(self, morphs, rest):
+        if morphs.n_vertices != len(rest):
+            raise ValueError(f"morph targets displace {morphs.n_vertices} vertices, the mesh "
+                             f"has {len(rest)}")
+        self.morphs = morphs
+        self.rest = rest
+        self.rest_normals = None
+        self.weights = np.zeros(morphs.count)   # the weights in the buffers
+        self.points, self.normals = rest, None  # what a skinning pass reads now
+        self._buf = self._nbuf = None
+        self._dirty = np.zeros(0, dtype=np.int64)  # rows of the buffers that differ from rest
+
+    def bind_normals(self, rest_normals):
+        """Use ``rest_normals`` (V, 3) float32 from now on (the weights re-applied)."""
+        self.rest_normals = rest_normals
+        self._nbuf = None
+        weights, self.weights = self.weights, np.full(self.morphs.count, np.nan)
+        self.set_weights(weights)
+
+    def set_weights(self, weights):
+        """Apply ``weights`` (anything :meth:`MorphTargets.weights_array` takes); returns
+        True when the points changed."""
+        mt = self.morphs
+        w = mt.weights_array(weights)
+        if np.array_equal(w, self.weights):
+            return False
+        self.weights = w
+        active = mt.active(w)
+        if not len(active):
+            self.points, self.normals = self.rest, self.rest_normals
+            return True
+        if self._buf is None:
+            self._buf, self._dirty = self.rest.copy(), np.zeros(0, dtype=np.int64)
+        with_normals = self.rest_normals is not None and mt.normal_deltas is not None
+        if with_normals and self._nbuf is None:
+            self._nbuf = self.rest_normals.copy()
+            self._nbuf_dirty = np.zeros(0, dtype=np.int64)
+        rows = np.unique(np.concatenate([mt.moved_rows(m) for m in active]))
+        self._reset(self._buf, self.rest, np.union1d(self._dirty, rows))
+        if with_normals:
+            self._reset(self._nbuf, self.rest_normals, np.union1d(self._nbuf_dirty, rows))
+            self._nbuf_dirty = rows
+        for m in active:
+            r, d, n = mt.sparse_target(m)
+            # rows are unique within one target: the fancy-index add is exact
+            self._buf[r] += np.float32(w[m]) * d
+            if with_normals:
+                self._nbuf[r] += np.float32(w[m]) * n
+        self._dirty = rows
+        self.points = self._buf
+        self.normals = self._nbuf if with_normals else self.rest_normals
+        return True
+
+    @staticmethod
+    def _reset(buf, rest, rows):
+        buf[rows] = rest[rows]

@@ -12,6 +12,7 @@ import scipy.sparse as sp
 from . import skinning_kernels
 from .dqs import dqs_skin, palette_dual_quaternions
 from .fast_paths import csr_times_dense_into
+from .morph import MorphedRest
 
 __all__ = ["SkinBinding", "linear_blend_skin", "top_k_influences", "dense_weights", "METHODS",
            "BACKENDS", "vertex_normals"]
@@ -102,6 +103,11 @@ class SkinBinding:
     weights : (V, K) float
         Influence weights; rows are renormalised to sum to 1.
     num_joints : int
+    morphs : rigedit.model.morph.MorphTargets, optional
+        Morph targets of the rest vertices: every pass skins ``rest + sum w * delta`` for the
+        weights of :meth:`set_morph_weights` (glTF's order: morph, then skin); the rest
+        normals get the normal deltas, renormalised by the pass. With all weights 0 a frame
+        reads the plain rest arrays, at no cost.
 
     Notes
     -----
@@ -113,7 +119,7 @@ class SkinBinding:
     allocated here, once.
     """
 
-    def __init__(self, rest_vertices, indices, weights, num_joints):
+    def __init__(self, rest_vertices, indices, weights, num_joints, morphs=None):
         rest = np.asarray(rest_vertices, dtype=np.float64)
         if rest.ndim != 2 or rest.shape[1] != 3:
             raise ValueError(f"expected rest vertices of shape (V, 3), got {rest.shape}")
@@ -162,6 +168,11 @@ class SkinBinding:
         self._scale = np.empty((self.num_joints, 9), dtype=np.float32)
         self._signs = np.empty((self.num_joints, self.num_joints), dtype=np.float32)
         self._rest_normals32 = None  # set by bind_normals
+        #: The morph targets (None without) and the rest arrays with their current weights.
+        self.morphs = morphs
+        self._morphed = None if morphs is None else MorphedRest(morphs, self._rest32)
+        if self._morphed is not None:
+            self._morphed.set_weights(None)          # the targets' default weights
         self._out_normals = None
         self._no_normals = np.empty((0, 3), dtype=np.float32)  # the DQS kernel without normals
         #: Threads of the compiled kernels: None picks one for small meshes, all for big ones
@@ -175,6 +186,29 @@ class SkinBinding:
     def dense(self):
         """(V, J) float64 weights."""
         return dense_weights(self.indices, self.weights, self.num_joints)
+
+    # ------------------------------------------------------------------ morphs
+    @property
+    def morph_weights(self):
+        """(M,) float64: the weights every pass applies (empty without morph targets)."""
+        return np.zeros(0) if self._morphed is None else self._morphed.weights.copy()
+
+    def set_morph_weights(self, weights):
+        """Set the morph weights the following passes apply: None (the targets' defaults),
+        (M,) numbers or ``{name: weight}`` (others keep their default). Only the rows the old
+        and new active targets move are rewritten. Returns True when the rest changed; a
+        binding without targets ignores weights (as a target's name that it lacks)."""
+        return False if self._morphed is None else self._morphed.set_weights(weights)
+
+    @property
+    def _rest_now(self):
+        """(V, 3) float32: the rest points with the current morphs (the rest itself without)."""
+        return self._rest32 if self._morphed is None else self._morphed.points
+
+    @property
+    def _normals_now(self):
+        """(V, 3) float32 or None: the rest normals with the current morphs."""
+        return self._rest_normals32 if self._morphed is None else self._morphed.normals
 
     def _kernels(self, backend):
         """The compiled kernels to use for ``backend``, or None for the numpy path."""
@@ -226,7 +260,7 @@ class SkinBinding:
         res = self._output(out)
         if kernels is not None and res.dtype == np.float32 and res.flags.c_contiguous:
             self._palette16.reshape(-1, 4, 4)[:] = np.asarray(palette).transpose(0, 2, 1)
-            kernels.run("lbs", len(res), self.threads, self._rest32, self._indices32,
+            kernels.run("lbs", len(res), self.threads, self._rest_now, self._indices32,
                         self._weights32, self._palette16, res)
             return res
         self._palette[:] = np.asarray(palette)[:, :3, :].reshape(-1, 12)
@@ -234,7 +268,7 @@ class SkinBinding:
         b = csr_times_dense_into(self.matrix, self._palette, self._blend).reshape(-1, 3, 4)
         # res = b[:, :, :3] @ rest + b[:, :, 3], written column by column into the buffers to
         # avoid the (V, 3, 3) temporaries an einsum would make.
-        r = self._rest32
+        r = self._rest_now
         tmp = self._tmp
         np.multiply(b[:, :, 0], r[:, 0:1], out=res)
         np.multiply(b[:, :, 1], r[:, 1:2], out=tmp)
@@ -253,6 +287,8 @@ class SkinBinding:
                              f"{n.shape}")
         self._rest_normals32 = np.ascontiguousarray(n, dtype=np.float32)
         self._out_normals = np.empty_like(self._rest_normals32)
+        if self._morphed is not None:
+            self._morphed.bind_normals(self._rest_normals32)
 
     def skin_with_normals(self, palette, backend=None, method="lbs"):
         """Vertex positions and normals in one pass. LBS: each vertex's blended 3x3 applied to
@@ -278,21 +314,22 @@ class SkinBinding:
             raise ValueError(f"expected a skinning method in {METHODS}, got {method!r}")
         kernels = self._kernels(backend)
         res, nrm = self._out, self._out_normals
+        normals = self._normals_now
         if method == "dqs":
             if kernels is not None:
-                self._run_dqs(kernels, palette, self._rest_normals32, res, nrm)
+                self._run_dqs(kernels, palette, normals, res, nrm)
             else:
-                res[:], nrm[:] = self._dqs_numpy(palette, self._rest_normals32)
+                res[:], nrm[:] = self._dqs_numpy(palette, normals)
             return res, nrm
         if kernels is not None:
             self._palette16.reshape(-1, 4, 4)[:] = np.asarray(palette).transpose(0, 2, 1)
-            kernels.run("lbs_normals", len(res), self.threads, self._rest32,
-                        self._rest_normals32, self._indices32, self._weights32,
+            kernels.run("lbs_normals", len(res), self.threads, self._rest_now,
+                        normals, self._indices32, self._weights32,
                         self._palette16, res, nrm)
             return res, nrm
         self.skin(palette, backend="numpy")  # fills self._blend with each vertex's 3x4
         b = self._blend.reshape(-1, 3, 4)
-        rn = self._rest_normals32
+        rn = normals
         np.einsum("vij,vj->vi", b[:, :, :3], rn, out=nrm)
         length = np.linalg.norm(nrm, axis=1, keepdims=True)
         np.divide(nrm, length, out=nrm, where=length > 0)
@@ -326,7 +363,10 @@ class SkinBinding:
         """The numpy reference of DQS (:func:`~rigedit.model.dqs.dqs_skin`): (V, 3) float64
         positions, and normals too when ``rest_normals`` (V, 3) is given."""
         dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
-        return dqs_skin(self.rest_vertices, self.indices, self.weights, dq,
+        rest = self._rest_now
+        # the float64 rest as bound unless morphs are active (then their float32 sum)
+        rest = self.rest_vertices if rest is self._rest32 else rest.astype(np.float64)
+        return dqs_skin(rest, self.indices, self.weights, dq,
                         scale if has_scale else None, rest_normals=rest_normals)
 
     def _run_dqs(self, kernels, palette, rest_normals, out, out_normals):
@@ -342,7 +382,7 @@ class SkinBinding:
             self._dq[:] = dq
             self._scale[:] = scale.reshape(-1, 9)
         skinning_kernels.hemisphere_signs(self._dq, self._signs)
-        kernels.run("dqs", len(out), self.threads, self._rest32, rest_normals,
+        kernels.run("dqs", len(out), self.threads, self._rest_now, rest_normals,
                     self._indices32, self._weights32, self._dq, self._signs, self._scale,
                     has_scale, out, out_normals)
 
