@@ -10,6 +10,16 @@ Values are local (parent-space) joint transforms, as in a Pose: translations, un
 quaternions (x, y, z, w), scales. A ``cubic_spline`` track (glTF's CUBICSPLINE) also has
 ``"tangents"``: per key, its in-tangent then its out-tangent (2 C numbers, units per second).
 
+Morph target weights (optional, absent in older files)::
+
+    "morph_tracks": [{"target": "smile", "interpolation": "LINEAR",
+                      "times": [0.0, 1.0], "values": [0.0, 1.0]}, ...]
+
+one per target, interpolation ``LINEAR``, ``STEP`` or ``CUBICSPLINE`` (glTF's names; a
+CUBICSPLINE track also has ``"in_tangents"`` and ``"out_tangents"``, one number per key,
+weight per second). Targets are names only: the clip does not know the mesh, and a rig
+ignores the weights of targets it lacks.
+
 elk format: ``{"name", "duration", "keyframes": {joint: [{"time", "rotation": [rx, ry, rz],
 "translation": [x, y, z], "scale": [x, y, z]}]}}`` with Euler radians composed Rz·Ry·Rx about
 the joint's head in its axis-aligned frame, translation an offset from the rest position, and
@@ -24,6 +34,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..animation.clip import CHANNELS, Clip, Track
+from ..animation.morph_track import WEIGHT_MODES, WeightTrack
 from ..errors import RigFileError
 from .atomic import write_json
 from .jsonfile import (MAX_SECONDS, boolean, choice, name, number, numbers, optional,
@@ -121,6 +132,37 @@ def _load_rigedit(path, data, skeleton):
     return tracks, _duration(path, data), _loop(path, data)
 
 
+def _load_morph_tracks(path, data):
+    """``{target: WeightTrack}`` of a rigedit clip's ``"morph_tracks"`` (empty without)."""
+    entries = optional(data, "morph_tracks", [])
+    if not isinstance(entries, list):
+        raise RigFileError(path, f"expected 'morph_tracks' to be a list, got "
+                                 f"{type(entries).__name__}")
+    tracks = {}
+    for i, e in enumerate(entries):
+        target = name(path, require(path, e, "target", str, f" in morph track {i}"),
+                      "'target'", where=f"morph track {i}")
+        where = f"morph track {i} ({target!r})"
+        if target in tracks:
+            raise RigFileError(path, f"{where}: a second track for the same target")
+        mode = choice(path, optional(e, "interpolation", "LINEAR"), "'interpolation'",
+                      WEIGHT_MODES, where=where)
+        times = numbers(path, require(path, e, "times", list, f" in {where}"), "'times'",
+                        bound=MAX_SECONDS, where=where)
+        if len(times) and times.min() < 0:
+            raise RigFileError(path, f"{where}: expected key times >= 0, got {times.min():g}")
+        values = numbers(path, require(path, e, "values", list, f" in {where}"), "'values'",
+                         count=len(times), where=where)
+        tangents = [None if optional(e, key, None) is None else
+                    numbers(path, e[key], repr(key), count=len(times), where=where)
+                    for key in ("in_tangents", "out_tangents")]
+        try:
+            tracks[target] = WeightTrack(times, values, mode, *tangents)
+        except ValueError as exc:
+            raise RigFileError(path, f"{where}: {exc}") from None
+    return tracks
+
+
 def load_clip(path, skeleton):
     """Read a clip in either format and bind it to ``skeleton``.
 
@@ -135,17 +177,19 @@ def load_clip(path, skeleton):
     data = read_json(path)
     if not isinstance(data, dict):
         raise RigFileError(path, f"expected a JSON object, got {type(data).__name__}")
+    morph_tracks = {}
     if "keyframes" in data:
         tracks, duration, loop = _load_elk(path, data, skeleton)
     elif "tracks" in data:
         tracks, duration, loop = _load_rigedit(path, data, skeleton)
+        morph_tracks = _load_morph_tracks(path, data)
     else:
         raise RigFileError(path, "expected a clip with 'tracks' (rigedit) or 'keyframes' (elk), "
                                  "got neither")
     clip_name = optional(data, "name", "")
     clip_name = path.stem if clip_name == "" else name(path, clip_name, "'name'")
     try:
-        return Clip(clip_name, skeleton, tracks, duration, loop)
+        return Clip(clip_name, skeleton, tracks, duration, loop, morph_tracks)
     except ValueError as exc:
         raise RigFileError(path, str(exc)) from None
 
@@ -158,8 +202,21 @@ def clip_to_dict(clip):
     for entry, tr in zip(tracks, clip.tracks.values()):
         if tr.interpolation == "cubic_spline":  # glTF's CUBICSPLINE keeps its own tangents
             entry["tangents"] = tr.tangents.reshape(len(tr), -1).round(9).tolist()
-    return {"format": "rigedit.clip", "version": 1, "name": clip.name,
-            "duration": clip.duration, "loop": clip.loop, "tracks": tracks}
+    out = {"format": "rigedit.clip", "version": 1, "name": clip.name,
+           "duration": clip.duration, "loop": clip.loop, "tracks": tracks}
+    if clip.morph_tracks:   # written only when there are some: older files stay as they were
+        out["morph_tracks"] = [_morph_track_dict(target, tr)
+                               for target, tr in clip.morph_tracks.items()]
+    return out
+
+
+def _morph_track_dict(target, tr):
+    entry = {"target": target, "interpolation": tr.interpolation,
+             "times": tr.times.round(9).tolist(), "values": tr.values.round(9).tolist()}
+    if tr.interpolation == "CUBICSPLINE":
+        entry["in_tangents"] = tr.in_tangents.round(9).tolist()
+        entry["out_tangents"] = tr.out_tangents.round(9).tolist()
+    return entry
 
 
 def save_clip(path, clip):

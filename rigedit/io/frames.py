@@ -109,7 +109,9 @@ def change_axes(skeleton, clips, R):
     out = {}
     for clip in items:
         tracks = {key: _change_track(track, R) for key, track in clip.tracks.items()}
-        out[clip.name] = Clip(clip.name, new, tracks, duration=clip.duration, loop=clip.loop)
+        # weight tracks are not spatial: they carry over as they are (tracks are immutable)
+        out[clip.name] = Clip(clip.name, new, tracks, duration=clip.duration, loop=clip.loop,
+                              morph_tracks=clip.morph_tracks)
     return new, out
 
 

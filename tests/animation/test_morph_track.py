@@ -66,3 +66,46 @@ def test_clip_samples_weights_counts_them_in_duration_and_undoes():
     copy = clip.copy("d")
     assert copy.morph_tracks["smile"] is not clip.morph_tracks["smile"]
     assert Clip("e", sk).sample_morphs(0.0) == {}
+
+
+# ---------------------------------------------------------------------- rigedit clip JSON
+import json  # noqa: E402
+
+from rigedit.errors import RigFileError  # noqa: E402
+from rigedit.io.clip_json import load_clip, save_clip  # noqa: E402
+
+
+def test_clip_json_round_trips_weight_tracks_of_every_mode(tmp_path):
+    sk = chain_skeleton(2)
+    clip = Clip("face", sk, morph_tracks={
+        "smile": WeightTrack([0.0, 0.5, 1.0], [0.0, 1.0, 0.2]),
+        "blink": WeightTrack([0.0, 1.0], [1.0, 0.0], "STEP"),
+        "jaw": WeightTrack([0.0, 2.0], [0.0, 1.0], "CUBICSPLINE", [0.1, 0.2], [0.3, 0.4])})
+    path = tmp_path / "face.json"
+    save_clip(path, clip)
+    back = load_clip(path, sk)
+    assert set(back.morph_tracks) == {"smile", "blink", "jaw"}
+    assert back.duration == 2.0
+    for t in np.linspace(0, 2, 17):
+        for name, w in clip.sample_morphs(t).items():
+            assert back.sample_morphs(t)[name] == pytest.approx(w, abs=1e-9)
+    assert list(back.morph_tracks["jaw"].out_tangents) == [0.3, 0.4]
+    # a clip without weight tracks writes none (files stay as before)
+    save_clip(path, Clip("plain", sk))
+    assert "morph_tracks" not in json.loads(path.read_text())
+
+
+@pytest.mark.parametrize("entry, words", [
+    ({"times": [0], "values": [1]}, "'target'"),
+    ({"target": "a", "times": [0, 1], "values": [1]}, "'values'"),
+    ({"target": "a", "times": [-1], "values": [1]}, ">= 0"),
+    ({"target": "a", "times": [0, 0], "values": [1, 2]}, "two keys"),
+    ({"target": "a", "times": [0], "values": [1], "interpolation": "slerp"}, "interpolation"),
+    ({"target": "", "times": [0], "values": [1]}, "non-empty"),
+    ({"target": "a", "times": [0], "values": ["x"]}, "'values'")])
+def test_malformed_weight_tracks_are_one_error_naming_the_file(tmp_path, entry, words):
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps({"tracks": [], "morph_tracks": [entry]}))
+    with pytest.raises(RigFileError, match=words) as err:
+        load_clip(path, chain_skeleton(2))
+    assert "bad.json" in str(err.value)
