@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from PyQt5 import QtCore, QtWidgets
+from PyQt5 import QtWidgets
 
 from .menus import make_action
 
@@ -188,13 +188,6 @@ class AutorigDialog(QtWidgets.QDialog):
         self.ok_button.setEnabled(not problem)
 
 
-class _StageRelay(QtCore.QObject):
-    """Carries the stage's name from the worker thread to the progress bar (a queued
-    signal: widgets are touched on the main thread only)."""
-
-    stage = QtCore.pyqtSignal(str)
-
-
 class AutorigAction:
     """File > Auto-rig mesh.
 
@@ -213,9 +206,6 @@ class AutorigAction:
         self.services = services
         self.replacing = replacing
         self.dialog = None
-        self.relay = _StageRelay()
-        self.relay.stage.connect(self._show_stage)
-        self._label = ""
 
     def actions(self):
         """name -> QAction for :func:`.menus.build_menus`."""
@@ -233,10 +223,6 @@ class AutorigAction:
         self.dialog.open()
         return self.dialog
 
-    def _show_stage(self, stage):
-        if self._label:
-            self.services.jobs.set_stage(self._label, stage)
-
     def start(self, mesh, template="humanoid", up=None, forward=None):
         """Auto-rig ``mesh`` off the UI thread; the result becomes the document. Returns
         the job (None when another job runs)."""
@@ -244,26 +230,18 @@ class AutorigAction:
         check = self.replacing("auto-rigging a mesh")
         if check is None:
             return None
-        relay = self.relay
-        self._label = f"Auto-rigging {mesh.name}"
+        label = f"Auto-rigging {mesh.name}"
 
         def work(report):
             from rigedit import autorig
 
-            last = [None]
-
-            def progress(fraction, stage=None):
-                report(fraction)  # raises Cancelled after the Cancel button
-                if stage and stage != last[0]:
-                    last[0] = stage
-                    relay.stage.emit(str(stage))
-
             report(0.0)
+            # report raises Cancelled after the Cancel button; the bar names each stage
             return autorig(str(mesh), template=template, up=up, forward=forward,
-                           progress=progress)
+                           progress=report)
 
-        return self.services.run_job(self._label, work,
-                                     lambda rig: self._done(mesh, rig, check))
+        return self.services.run_job(label, work, lambda rig: self._done(mesh, rig, check),
+                                     show_stage=True)
 
     def _done(self, mesh, rig, check=lambda: True):
         if not check():
