@@ -80,7 +80,7 @@ def main(argv=None, prog="rigedit-editor"):
     errors_hook.enable_faulthandler()
     notifier = autosave.install_signal_handlers(  # noqa: F841 - keep it alive
         app, window.autosave, window.keep_recovery_entry)
-    QtCore.QTimer.singleShot(0, lambda: autosave.offer_recovery(window))
+    QtCore.QTimer.singleShot(0, window.autosave.offer_recovery)
     # The compiled skinning kernels load (from numba's disk cache) in the background once the
     # window is up, so they neither delay the first frame nor get compiled during a drag.
     from ..model import skinning_kernels

@@ -49,6 +49,8 @@ class Autosave(QtCore.QObject):
     document : Document
     status : callable
         ``status(text)``: a failed write is said there.
+    error : callable
+        ``error(title, message)``: a recovery that cannot be done.
     interacting : callable, optional
         ``interacting()`` is True while a gizmo drag is held (no write then).
     interval : float, optional
@@ -68,10 +70,12 @@ class Autosave(QtCore.QObject):
 
     _windows = 0
 
-    def __init__(self, parent, document, status, interacting=lambda: False, interval=None):
+    def __init__(self, parent, document, status, error, interacting=lambda: False,
+                 interval=None):
         super().__init__(parent)
         self.document = document
         self.status = status
+        self.error = error
         self.interacting = interacting
         Autosave._windows += 1  # each window of a process has its own entry
         self.folder = recovery.entry_folder(window=Autosave._windows)
@@ -209,11 +213,58 @@ class Autosave(QtCore.QObject):
     def stop(self):
         self.timer.stop()
 
+    # ------------------------------------------------------------------ recovery at start
+    def offer_recovery(self, ask=None):
+        """Offer each entry left by an editor that no longer runs, newest first. The first
+        one recovered replaces the document (the rest stay for a later start).
+
+        Parameters
+        ----------
+        ask : callable, optional
+            ``ask(parent, entry) -> "recover" | "discard" | "later"`` (:func:`ask_recover`).
+
+        Returns
+        -------
+        RecoveryEntry or None
+            The entry recovered.
+        """
+        ask = ask or ask_recover
+        for entry in recovery.stale_entries():
+            choice = ask(self.parent(), entry)
+            if choice == "discard":
+                recovery.remove_entry(entry.folder)
+            elif choice == "recover" and self.recover(entry):
+                return entry
+        return None
+
+    def recover(self, entry):
+        """Open a recovery entry as an unsaved document (its Save goes to the original
+        folder; Save As when there was none or it was a bundled character). The entry is
+        removed once this editor's own recovery snapshot holds the work. Returns success."""
+        doc = self.document
+        if doc.modified:  # never replace unsaved work with other unsaved work
+            self.error("Recover", f"save or discard the changes to {doc.rig.name} first, "
+                                  f"then recover {entry.describe()}")
+            return False
+        try:
+            rig, pose, clip, time = recovery.read_entry(entry)
+        except (RigFileError, ValueError, OSError) as exc:
+            self.error("Recover", f"cannot recover {entry.describe()}: {exc}")
+            return False
+        doc.set_rig(rig, modified=True)
+        doc.set_current_clip(clip)
+        doc.set_time(time)
+        doc.set_pose(pose)
+        if self.save(force=True):
+            recovery.remove_entry(entry.folder)
+        self.status(f"Recovered {entry.describe()}; save it to keep it")
+        return True
+
 
 # ---------------------------------------------------------------------- recovery at start
-def ask_recover(window, entry):
+def ask_recover(parent, entry):
     """Ask what to do with a recovery entry: "recover", "discard" or "later"."""
-    box = QtWidgets.QMessageBox(window)
+    box = QtWidgets.QMessageBox(parent)
     box.setIcon(QtWidgets.QMessageBox.Question)
     box.setWindowTitle("Recover unsaved work")
     box.setText("An editor that is no longer running left unsaved work:")
@@ -230,61 +281,23 @@ def ask_recover(window, entry):
 
 
 def offer_recovery(window, ask=None):
-    """Offer each entry left by an editor that no longer runs, newest first. The first one
-    recovered replaces the window's document (the rest stay for a later start).
-
-    Parameters
-    ----------
-    ask : callable, optional
-        ``ask(window, entry) -> "recover" | "discard" | "later"`` (:func:`ask_recover`).
-
-    Returns
-    -------
-    RecoveryEntry or None
-        The entry recovered.
-    """
-    ask = ask or ask_recover
-    for entry in recovery.stale_entries():
-        choice = ask(window, entry)
-        if choice == "discard":
-            recovery.remove_entry(entry.folder)
-        elif choice == "recover" and recover(window, entry):
-            return entry
-    return None
+    """:meth:`Autosave.offer_recovery` of ``window``'s autosave."""
+    return window.autosave.offer_recovery(ask)
 
 
 def recover(window, entry):
-    """Open a recovery entry in ``window`` as an unsaved document (its Save goes to the
-    original folder; Save As when there was none or it was a bundled character). The entry
-    is removed once this editor's own recovery snapshot holds the work. Returns success."""
-    if window.document.modified:  # never replace unsaved work with other unsaved work
-        window.error("Recover", f"save or discard the changes to {window.document.rig.name} "
-                                f"first, then recover {entry.describe()}")
-        return False
-    try:
-        rig, pose, clip, time = recovery.read_entry(entry)
-    except (RigFileError, ValueError, OSError) as exc:
-        window.error("Recover", f"cannot recover {entry.describe()}: {exc}")
-        return False
-    doc = window.document
-    doc.set_rig(rig, modified=True)
-    doc.set_current_clip(clip)
-    doc.set_time(time)
-    doc.set_pose(pose)
-    if window.autosave.save(force=True):
-        recovery.remove_entry(entry.folder)
-    window.status(f"Recovered {entry.describe()}; save it to keep it")
-    return True
+    """:meth:`Autosave.recover` of ``window``'s autosave."""
+    return window.autosave.recover(entry)
 
 
 # ---------------------------------------------------------------------- closing
-def ask_save_changes(window, action="closing"):
-    """Ask about unsaved changes before ``action`` ("closing", "opening another rig", ...):
-    "save", "discard" or "cancel"."""
-    box = QtWidgets.QMessageBox(window)
+def ask_save_changes(parent, name, action="closing"):
+    """Ask about the unsaved changes to ``name`` before ``action`` ("closing", "opening
+    another rig", ...): "save", "discard" or "cancel"."""
+    box = QtWidgets.QMessageBox(parent)
     box.setIcon(QtWidgets.QMessageBox.Warning)
     box.setWindowTitle("Unsaved changes")
-    box.setText(f"Save the changes to {window.document.rig.name} before {action}?")
+    box.setText(f"Save the changes to {name} before {action}?")
     box.setInformativeText(f"{action[:1].upper()}{action[1:]} without saving loses them "
                            "(no recovery file is kept).")
     box.setStandardButtons(QtWidgets.QMessageBox.Save | QtWidgets.QMessageBox.Discard
@@ -295,15 +308,16 @@ def ask_save_changes(window, action="closing"):
             QtWidgets.QMessageBox.Discard: "discard"}.get(answer, "cancel")
 
 
-def confirm_unsaved_changes(window, ask=None, action="closing"):
+def confirm_unsaved_changes(parent, document, save, ask=None, action="closing"):
     """Whether the window may close (or its document be replaced: ``action`` says by what,
     e.g. "opening another rig"): no unsaved changes, or the user discarded them, or they
-    were saved (File > Save; Save As when there is no folder to save to)."""
-    if not window.document.modified:
+    were saved by ``save()`` (File > Save; Save As when there is no folder to save to).
+    ``ask(parent, name, action=...)`` is :func:`ask_save_changes` by default."""
+    if not document.modified:
         return True
-    choice = (ask or ask_save_changes)(window, action=action)
+    choice = (ask or ask_save_changes)(parent, document.rig.name, action=action)
     if choice == "save":
-        return bool(window.files.save()) and not window.document.modified
+        return bool(save()) and not document.modified
     return choice == "discard"
 
 

@@ -134,7 +134,7 @@ class MainWindow(QtWidgets.QMainWindow):
         sb.addPermanentWidget(self.view_actions.mode_label)
         self._build_docks()
         self.files = FileActions(d, services, lambda: self.confirm_close,
-                                 lambda action: confirm_unsaved_changes(self, action=action),
+                                 lambda action: self._may_drop_changes(action),
                                  self.screenshot, self.close)
         self.autorig = AutorigAction(d, services, self.files.replacing)
         self.reembed = ReembedAction(d, services)
@@ -150,7 +150,7 @@ class MainWindow(QtWidgets.QMainWindow):
         # a big mesh is drawn as its decimated proxy while it moves (issue 12)
         self.proxy_view = ProxyView(lambda: view.scene, d, sb, view.request_render,
                                     lambda: view.weights_view)
-        self.autosave = Autosave(self, d, self.status, lambda: view.interacting)
+        self.autosave = Autosave(self, d, self.status, self.error, lambda: view.interacting)
         self._build_menus()
         errors_hook.install(self)
         self.resize(1440, 900)
@@ -283,6 +283,10 @@ class MainWindow(QtWidgets.QMainWindow):
         """
         return window_image(self, self.plotter, path)
 
+    def _may_drop_changes(self, action="closing"):
+        """Unsaved changes may go before ``action``: none, saved, or discarded by the user."""
+        return confirm_unsaved_changes(self, self.document, self.files.save, action=action)
+
     def keep_recovery_entry(self):
         """Closing keeps the recovery entry (quitting on a signal: the next start offers it)."""
         self.keep_recovery = True
@@ -291,8 +295,7 @@ class MainWindow(QtWidgets.QMainWindow):
         if self._closed:  # closed before (tests close twice): nothing left to ask or free
             super().closeEvent(event)
             return
-        if self.confirm_close and not self.keep_recovery \
-                and not confirm_unsaved_changes(self):
+        if self.confirm_close and not self.keep_recovery and not self._may_drop_changes():
             event.ignore()  # the user chose Cancel, or the save did not happen
             return
         self._closed = True

@@ -167,7 +167,8 @@ def test_closing_with_unsaved_changes_asks(make_editor, monkeypatch, tmp_path):
     from rigedit.ui import autosave
 
     answers = []
-    monkeypatch.setattr(autosave, "ask_save_changes", lambda w, action: answers.pop(0))
+    monkeypatch.setattr(autosave, "ask_save_changes",
+                        lambda parent, name, action: answers.pop(0))
     w = make_editor()
     w.confirm_close = True
     assert w.close()  # nothing unsaved: no question

@@ -16,7 +16,7 @@ def asked(monkeypatch):
 
     log = {"answers": [], "actions": []}
 
-    def ask(window, action):
+    def ask(parent, name, action):
         log["actions"].append(action)
         return log["answers"].pop(0)
 
