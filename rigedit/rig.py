@@ -123,7 +123,7 @@ class Rig:
         old = getattr(self, "binding", None)
         self.binding = SkinBinding(self.vertices, indices, weights, len(self.skeleton),
                                    morphs=self.morphs)
-        if old is not None and self.morphs is not None:
+        if old is not None and self.morphs is not None and old.morphs is self.morphs:
             self.binding.set_morph_weights(old.morph_weights)
 
     @property

@@ -4,12 +4,13 @@ It watches the history (an observer of the undo stack, called before the documen
 the change, so listeners hear of the step with its keys already in it): a new step pushed that is a pose
 edit (not a clip edit, not an undo or redo) in pose mode, with a current clip and no drag held,
 keys the joints whose pose now differs from the clip, folded into that same step, as the user
-made one edit.
+made one edit. A morph weight edit (:mod:`.morphs`) keys the targets whose weight differs.
 """
 from __future__ import annotations
 
 from .clip_edits import ClipCommand
 from .key_commands import changed_joints, set_key
+from .morphs import MorphCommand, changed_targets, key_weight
 
 __all__ = ["AutoKey"]
 
@@ -38,6 +39,11 @@ class AutoKey:
         if (not self.enabled or stack.last_action != "push" or isinstance(stack.top, ClipCommand)
                 or d.clip is None or d.mode != "pose" or d.dragging):
             return []
+        if isinstance(stack.top, MorphCommand):
+            targets = changed_targets(d)
+            for target in targets:
+                key_weight(d, target, amend=True)
+            return targets
         joints = changed_joints(d)
         if joints:
             set_key(d, joints=joints, amend=True, label=f"auto-key {', '.join(joints)}")

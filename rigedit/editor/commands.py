@@ -5,7 +5,8 @@ The Document's own methods (:class:`~rigedit.editor.document.Document`) hold the
 ``set_current_clip``), pose edits (``set_pose``, ``set_joint_euler``, ``set_joint_translation``,
 ``set_joint_scale``, ``reset_joint``, ``reset_pose``, ``mirror_pose``, ``begin_drag`` /
 ``drag_euler`` / ``end_drag``), rest and weight edits (``push_rest_edit``, ``set_weights``)
-and history (``undo``, ``redo``). The rest are functions taking the document, gathered here::
+and history (``undo``, ``redo``); the morph weights shown are ``document.morph``. The rest
+are functions taking the document, gathered here::
 
     from rigedit.editor import commands as cmd
 
@@ -27,6 +28,7 @@ from .drag import PoseDrag
 from .files import export_rig, open_document, open_rig, save_rig_folder
 from .key_commands import (KeyDrag, copy_keys, delete_key, key_near, move_keys, paste_keys,
                            set_interpolation, set_key)
+from .morphs import WeightDrag, delete_weight_key, key_weight, set_weight
 from .recompute import RecomputeWeights, recompute_weights
 from .weight_stroke import WeightStroke
 
@@ -34,4 +36,5 @@ __all__ = ["open_document", "open_rig", "save_rig_folder", "export_rig", "PoseDr
            "set_key", "key_near", "delete_key", "move_keys", "KeyDrag", "copy_keys", "paste_keys",
            "set_interpolation", "new_clip", "add_clip", "rename_clip", "duplicate_clip",
            "delete_clip", "set_duration", "unique_clip_name", "WeightStroke",
-           "set_joint_deform", "RecomputeWeights", "recompute_weights"]
+           "set_joint_deform", "RecomputeWeights", "recompute_weights", "set_weight",
+           "WeightDrag", "key_weight", "delete_weight_key"]

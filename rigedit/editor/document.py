@@ -8,9 +8,9 @@ functions taking the document: :mod:`rigedit.editor.commands` lists them all.
 
 Every change is announced to the listeners as one of the typed events of
 :mod:`rigedit.editor.events` (:meth:`Document.listen`); listeners registered the old way
-(:meth:`Document.subscribe`) receive ``callback(name, **info)`` with the same names as
-before: ``"rig"``, ``"pose"`` (``joints``), ``"rest"``, ``"selection"`` (``joint``),
-``"time"`` (``time``), ``"clip"`` (``name``), ``"undo"``, and now ``"mode"`` (``mode``).
+(:meth:`Document.subscribe`) receive ``callback(name, **info)``: ``"rig"``, ``"pose"``
+(``joints``), ``"rest"``, ``"selection"`` (``joint``), ``"time"`` (``time``), ``"clip"``
+(``name``), ``"undo"``, ``"mode"`` (``mode``), ``"morph"`` (``weights``).
 """
 from __future__ import annotations
 
@@ -21,6 +21,7 @@ from ..model.skinning import SkinBinding
 from . import events as ev
 from .auto_key import AutoKey
 from .mirror import mirror_map, mirror_name, mirror_pose, side_axis
+from .morphs import MorphWeights
 from .undo import Command, UndoStack
 
 __all__ = ["Command", "UndoStack", "Document", "mirror_name", "mirror_map", "mirror_pose",
@@ -55,6 +56,8 @@ class Document:
         is :meth:`set_mode`.
     auto_key : AutoKey
         When ``auto_key.enabled``, pose edits write keys at the current time.
+    morph : MorphWeights
+        The morph target weights shown (:mod:`rigedit.editor.morphs`), sampled with the pose.
     modified : bool
         Whether the data differs from what was last saved or opened (undoing back to the
         saved state makes it false again).
@@ -66,6 +69,7 @@ class Document:
         self.undo_stack.observers.append(lambda: self.emit("undo"))
         self._mode = "pose"
         self._drag_before = None
+        self.morph = MorphWeights(self)
         self._set_rig(rig)
         self._saved_top = None  # the undo stack's top command when last saved or opened
         self.auto_key = AutoKey(self)   # watches the undo stack before the listeners hear
@@ -103,8 +107,7 @@ class Document:
         self.current_clip = next(iter(rig.clips), None)
         self.time = 0.0
         if len(rig.vertices) == 0 and self.current_clip is not None:
-            # a skeleton without a mesh (BVH) has an arbitrary rest pose (Bandai's lies flat):
-            # show its motion's first frame, where the timeline starts
+            # a mesh-less skeleton's (BVH) rest is arbitrary: show the motion's first frame
             self._sample_into_pose()
         self.mirror = mirror_map(rig.skeleton.names)
 
@@ -133,13 +136,8 @@ class Document:
         self._saved_top = _NEVER_SAVED
         self.emit("undo")
 
-    @property
-    def skeleton(self):
-        return self.rig.skeleton
-
-    @property
-    def clips(self):
-        return self.rig.clips
+    skeleton = property(lambda self: self.rig.skeleton)
+    clips = property(lambda self: self.rig.clips)
 
     @property
     def clip(self):
@@ -186,6 +184,7 @@ class Document:
         if clip is None or self.dragging:
             return False
         clip.sample(self.time, out=self.pose)
+        self.morph.sample(clip, self.time)   # the weights with the pose (MorphChanged)
         return True
 
     def set_time(self, t, sample=True):
@@ -298,8 +297,8 @@ class Document:
                        lambda p: mirror_pose(p, self.mirror, self.skeleton.names,
                                              self._side_axis(), source))
 
-    def _side_axis(self):
-        return side_axis(self.skeleton, self.mirror)   # the model axis running left-right
+    def _side_axis(self):   # the model axis running left-right
+        return side_axis(self.skeleton, self.mirror)
 
     # ------------------------------------------------------------------ rest pose and binding
     def rest_state(self):
@@ -309,7 +308,8 @@ class Document:
 
     def make_rest_state(self, skeleton, indices, weights, pose=None):
         """A state for :meth:`push_rest_edit` from new weights (validated here)."""
-        binding = SkinBinding(self.rig.vertices, indices, weights, len(skeleton))
+        binding = SkinBinding(self.rig.vertices, indices, weights, len(skeleton),
+                              morphs=self.rig.morphs)
         return (skeleton, binding, self.pose_snapshot() if pose is None else np.array(pose))
 
     def apply_rest_state(self, state):
@@ -319,9 +319,8 @@ class Document:
         if len(skeleton) != len(self.skeleton) or binding.num_vertices != len(self.rig.vertices):
             raise ValueError("expected a rest state of this rig's joints and vertices")
         same_skeleton, same_binding = skeleton is self.rig.skeleton, binding is self.rig.binding
-        self.rig.skeleton = skeleton
-        self.pose.skeleton = skeleton
-        self.rig.binding = binding
+        binding.set_morph_weights(self.rig.binding.morph_weights)   # the weights shown stay
+        self.rig.skeleton, self.pose.skeleton, self.rig.binding = skeleton, skeleton, binding
         self.pose.set_array(pose)
         self.emit(ev.WeightsChanged() if same_skeleton else ev.RestChanged(not same_binding))
         self.emit(ev.PoseChanged())

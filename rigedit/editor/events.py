@@ -16,7 +16,7 @@ from typing import ClassVar, Optional, Tuple
 
 __all__ = ["Event", "RigReplaced", "PoseChanged", "RestChanged", "WeightsChanged",
            "SelectionChanged", "TimeChanged", "ClipChanged", "KeysChanged", "ModeChanged",
-           "UndoChanged", "Listeners", "from_name"]
+           "UndoChanged", "MorphChanged", "Listeners", "from_name"]
 
 
 @dataclass(frozen=True)
@@ -114,6 +114,20 @@ class ModeChanged(Event):
 
 
 @dataclass(frozen=True)
+class MorphChanged(Event):
+    """The morph target weights shown changed (a slider, an undo, the clip sampled).
+
+    Attributes
+    ----------
+    weights : tuple of float
+        (M,) the weights now, in the order of ``rig.morphs.names``.
+    """
+
+    name: ClassVar[str] = "morph"
+    weights: Tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
 class UndoChanged(Event):
     """The history or the saved state changed.
 
@@ -137,7 +151,7 @@ class UndoChanged(Event):
 #: The typed event for each old string name, for code that still emits strings.
 _BY_NAME = {"rig": RigReplaced, "pose": PoseChanged, "rest": RestChanged,
             "selection": SelectionChanged, "time": TimeChanged, "clip": ClipChanged,
-            "mode": ModeChanged, "undo": UndoChanged}
+            "mode": ModeChanged, "undo": UndoChanged, "morph": MorphChanged}
 
 
 def from_name(event, /, **info):
