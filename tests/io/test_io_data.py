@@ -88,15 +88,22 @@ def test_gltf_reads_as_data():
 
 
 def test_every_format_is_one_registry_line(tmp_path):
-    assert [f.name for f in FORMATS] == ["folder", "gltf", "bvh"]
-    assert RIG_FILE_SUFFIXES == (".glb", ".gltf", ".bvh")
-    assert format_of(tmp_path).name == "folder" and format_of(tmp_path / "a.GLB").name == "gltf"
+    names = [f.name for f in FORMATS]
+    assert names[:3] == ["folder", "gltf", "bvh"] and len(set(names)) == len(names)
+    assert RIG_FILE_SUFFIXES[:3] == (".glb", ".gltf", ".bvh")
+    assert len(set(RIG_FILE_SUFFIXES)) == len(RIG_FILE_SUFFIXES)   # one format per suffix
+    for fmt in FORMATS:
+        assert callable(fmt.read) and callable(fmt.write)
+        for suffix in fmt.suffixes:
+            assert format_of(tmp_path / f"a{suffix.upper()}") is fmt
+    assert format_of(tmp_path).name == "folder"
     assert format_of(tmp_path / "new", role="write").name == "folder"
     (tmp_path / "a.obj").write_text("")
-    with pytest.raises(RigFileError, match="expected a rig folder or a .glb, .gltf or .bvh"):
+    with pytest.raises(RigFileError, match=r"expected a rig folder or a \.glb, \.gltf.* file, "
+                                           r"got a \.obj file"):
         format_of(tmp_path / "a.obj")
-    with pytest.raises(RigFileError, match="expected a folder or a .glb, .gltf or .bvh file to "
-                                           "write, got a .obj file"):
+    with pytest.raises(RigFileError, match=r"expected a folder or a \.glb, \.gltf.* file to "
+                                           r"write, got a \.obj file"):
         format_of(tmp_path / "a.obj", role="write")
 
 
