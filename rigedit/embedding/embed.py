@@ -162,16 +162,8 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None,
         (a ValueError) naming the joint of a hint that is not the template's or lies
         outside the mesh.
     """
-    seconds = {}
     report = adapt(progress, "embed")
-
-    def stage(name, fraction, fn, *args, **kw):
-        t0 = time.perf_counter()
-        out = fn(*args, **kw)
-        seconds[name] = time.perf_counter() - t0
-        report(fraction)
-        return out
-
+    stage = _Stages(report)
     report(0.0)
     vertices, faces = _check_mesh(vertices, faces)
     try:
@@ -188,24 +180,75 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None,
     graph = stage("graph", 0.55, medial_graph, field_, *spheres)
     frame = _frame(vertices, faces)
     frame["cell"] = field_.h
+    scale = _first_scale(reduced, frame)
+    sub = scaled(report, 0.55, 0.8) if progress is not None else None
+    found = _search(stage, graph, reduced, template, frame, scale, sub, field_, pins)
+    positions, ok, paths = _graph_positions(graph, reduced, found.vertex, pins)
+    hold = W_SCALE_FIRM if np.isfinite(reduced.height) else W_SCALE_WEAK
+    chains = _pin(place_chains(reduced, positions, paths, scale=scale), pins)
+    out, scale = stage("refinement", 0.95, fit_joints, field_, reduced, chains, scale,
+                       frame["floor"], hold, graph.points, frame["plane_x"], pins)
+    out = _thighs_apart(field_, reduced, out, frame["plane_x"], template_mesh, pins)
+    # hinted carried joints first, so that the carried joints below them follow
+    out = stage("placement", 1.0, place_carried, reduced, _pin(out, pins), scale,
+                frame["floor"])
+    placed_mask = np.zeros(len(out), dtype=bool)
+    for r in np.flatnonzero(ok):
+        placed_mask[reduced.chains[r][1:] if r else [reduced.joints[0]]] = True
+    placed_mask[list(pins)] = True
+    t0 = time.perf_counter()
+    out, cut, gone = keep_inside(field_, out, reduced.parents, placed_mask, vertices, faces,
+                                 reduced.mirror_all)
+    stage.seconds["placement"] += time.perf_counter() - t0
+    return Embedding(out, stage.seconds, float(found.cost),
+                     [template.names[j] for j in np.flatnonzero(placed_mask)], float(scale),
+                     np.c_[graph.points, graph.radii],
+                     {template.names[j]: s for j, s in cut.items()},
+                     [template.names[j] for j in gone])
+
+
+class _Stages:
+    """Runs the embedding's stages, each timed into ``seconds`` (by name) and reported to
+    ``report`` (its fraction done when it ends)."""
+
+    def __init__(self, report):
+        self.report = report
+        self.seconds = {}
+
+    def __call__(self, name, fraction, fn, *args, **kw):
+        t0 = time.perf_counter()
+        out = fn(*args, **kw)
+        self.seconds[name] = time.perf_counter() - t0
+        self.report(fraction)
+        return out
+
+
+def _first_scale(reduced, frame):
+    """Mesh units per template unit, from the two heights and areas (a template with its
+    own mesh) or from the mesh's height against the template's joints' (without)."""
     kept = reduced.rest[~reduced.carried]
     if np.isfinite(reduced.height):
         # Height says how big a standing character is but shrinks in a crouch; surface area
         # does not change with the pose but grows with girth: take the geometric mean.
-        scale = np.sqrt(frame["height"] / max(reduced.height, 1e-12)
-                        * np.sqrt(frame["area"] / max(reduced.area, 1e-300)))
-    else:
-        scale = frame["height"] / max(np.max(kept[:, 1]) - reduced.floor, 1e-12) / 1.1
+        return np.sqrt(frame["height"] / max(reduced.height, 1e-12)
+                       * np.sqrt(frame["area"] / max(reduced.area, 1e-300)))
+    return frame["height"] / max(np.max(kept[:, 1]) - reduced.floor, 1e-12) / 1.1
+
+
+def _search(stage, graph, reduced, template, frame, scale, progress, field_, pins):
+    """The discrete embedding (:func:`.search.discrete_embedding`, timed as ``search``),
+    refused (:class:`EmbeddingError` naming the part of the template that found no place)
+    when the graph is too small, nothing fits, or the best fit costs over
+    :data:`MAX_COST_PER_BONE` per reduced bone; its tails extended."""
     if len(graph.points) < len(reduced.joints):
         raise EmbeddingError(
             f"no place found for the template's {reduced.label(template, 1)}: the mesh has "
             f"{len(graph.points)} medial spheres, expected at least {len(reduced.joints)} "
             "(is it a blob without limbs?)")
     t0 = time.perf_counter()
-    sub = scaled(report, 0.55, 0.8) if progress is not None else None
-    found = discrete_embedding(graph, reduced, frame, scale, sub, field_, pins)
-    seconds["search"] = time.perf_counter() - t0
-    report(0.8)
+    found = discrete_embedding(graph, reduced, frame, scale, progress, field_, pins)
+    stage.seconds["search"] = time.perf_counter() - t0
+    stage.report(0.8)
     if found.vertex is None:
         raise EmbeddingError(f"no place found for the template's "
                              f"{reduced.label(template, found.failed)}")
@@ -222,37 +265,31 @@ def embed_skeleton(vertices, faces, template, progress=None, template_mesh=None,
             f"{MAX_COST_PER_BONE * max(len(reduced.joints) - 1, 1):.0f} (is the mesh a blob "
             "without limbs, or posed far from the template?)")
     found.vertex = extend_tails(graph, reduced, found.vertex)
+    return found
+
+
+def _graph_positions(graph, reduced, vertex, pins):
+    """The reduced joints where the search put them (pinned ones at their pins):
+    ``positions`` (R, 3) (NaN where carried), ``ok`` (R,) bool (placed) and ``paths``, per
+    reduced joint the graph's path (K, 3) from its parent's place to its own (None for the
+    root and carried joints)."""
     positions = np.full((len(reduced.joints), 3), np.nan)
-    ok = found.vertex >= 0
-    positions[ok] = graph.points[found.vertex[ok]]
-    paths = [None] + [graph.points[graph.path(found.vertex[reduced.parent[r]], found.vertex[r])]
+    ok = vertex >= 0
+    positions[ok] = graph.points[vertex[ok]]
+    paths = [None] + [graph.points[graph.path(vertex[reduced.parent[r]], vertex[r])]
                       if ok[r] else None for r in range(1, len(ok))]
     for r, j in enumerate(reduced.joints):
         if j in pins and ok[r]:
             positions[r] = pins[j]
-    hold = W_SCALE_FIRM if np.isfinite(reduced.height) else W_SCALE_WEAK
-    chains = _pin(place_chains(reduced, positions, paths, scale=scale), pins)
-    out, scale = stage("refinement", 0.95, fit_joints, field_, reduced, chains, scale,
-                       frame["floor"], hold, graph.points, frame["plane_x"], pins)
-    # a deep trunk lifts the hips' sphere centre: the thighs go where the legs part (not
-    # when the user pinned a leg's joints: they said where the legs are)
+    return positions, ok, paths
+
+
+def _thighs_apart(field_, reduced, out, plane_x, template_mesh, pins):
+    """A deep trunk lifts the hips' sphere centre: the thighs go where the legs part
+    (:func:`.legs.lower_leg_tops`), but not when the user pinned a leg's joints (they said
+    where the legs are). ``out`` (J, 3) -> (J, 3)."""
     above = LEG_TOP if template_mesh is None else template_leg_top(reduced, *template_mesh)
-    tops = leg_top_heights(field_, reduced, out, frame["plane_x"], above)
+    tops = leg_top_heights(field_, reduced, out, plane_x, above)
     if not _leg_pinned(reduced, pins):
         out = lower_leg_tops(reduced, out, tops)
-    # hinted carried joints first, so that the carried joints below them follow
-    out = stage("placement", 1.0, place_carried, reduced, _pin(out, pins), scale,
-                frame["floor"])
-    placed_mask = np.zeros(len(out), dtype=bool)
-    for r in np.flatnonzero(ok):
-        placed_mask[reduced.chains[r][1:] if r else [reduced.joints[0]]] = True
-    placed_mask[list(pins)] = True
-    t0 = time.perf_counter()
-    out, cut, gone = keep_inside(field_, out, reduced.parents, placed_mask, vertices, faces,
-                               reduced.mirror_all)
-    seconds["placement"] += time.perf_counter() - t0
-    placed = [template.names[j] for j in np.flatnonzero(placed_mask)]
-    return Embedding(out, seconds, float(found.cost), placed, float(scale),
-                     np.c_[graph.points, graph.radii],
-                     {template.names[j]: s for j, s in cut.items()},
-                     [template.names[j] for j in gone])
+    return out

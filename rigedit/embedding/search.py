@@ -120,14 +120,147 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None,
         ``vertex`` is None when nothing fits; ``failed`` then names the reduced joint.
     """
     progress = None if progress is None else adapt(progress)
+    return _Searcher(graph, template, frame, scale, field, hints).run(progress)
+
+
+class _Searcher:
+    """The search's cost tables, its expansion of a partial embedding, and the search.
+
+    A partial embedding is a state ``(f, g, assign, pending)``: its cost plus bound, its
+    cost, the graph vertex of each reduced joint placed so far (in order; -1 carried), and
+    the (joint, bound) pairs already added to ``f`` for mirror partners to come.
+    """
+
+    def __init__(self, graph, template, frame, scale, field, hints):
+        self.pts, self.dist = graph.points, graph.dist
+        self.template, self.frame = template, frame
+        self.r, self.n = len(template.joints), len(self.pts)
+        self.parent = template.parent
+        self.children = [np.flatnonzero(self.parent == k) for k in range(self.r)]
+        rest = template.rest[template.joints]
+        # joints standing on the ground (ankles, hooves): their height is a strong cue
+        low = rest[:, 1] - template.floor < FEET * np.ptp(template.rest[~template.carried, 1])
+        self.unit = 0.05 * template.size * scale
+        self.unary, self.pair = _cost_tables(graph, template, frame, scale, low, hints,
+                                             self.unit)
+        self.down, self.best = _tree_bounds(template, self.unary, self.pair, self.children,
+                                            self.n)
+        self.partner = _partners(template, low, self.children, field, self.pts)
+        self.later_mirror = np.full(self.r, -1)
+        for k in range(self.r):
+            if template.mirror[k] > k:
+                self.later_mirror[k] = template.mirror[k]
+        self.stuck = np.zeros(self.r, dtype=np.int64)
+
+    def coupling(self, k, assign):
+        """:func:`_coupling` of joint ``k`` given ``assign``."""
+        return _coupling(k, assign, self.pts, self.dist, self.template, self.partner,
+                         self.frame, self.unit)
+
+    def expand(self, state):
+        """The children of a partial embedding (see the class notes)."""
+        f, g, assign, pending = state
+        parent, best, template = self.parent, self.best, self.template
+        k = len(assign)
+        a = assign[parent[k]]
+        own = sum(extra for j, extra in pending if j == k)
+        pending = tuple(p for p in pending if p[0] != k)
+        h_rest = f - g - (best[k][a] if a >= 0 else 0.0) - own
+        if a < 0:  # the parent is carried, so is this joint
+            return [(f - own, g, assign + (-1,), pending)]
+        used = np.array([v for v in assign if v >= 0])
+        gk = self.pair[k][a] + self.unary[k] + self.coupling(k, assign)
+        gk[used] = np.inf
+        hk = sum((best[c] for c in self.children[k]), np.zeros(self.n))
+        fk = g + gk + hk + h_rest
+        order = np.argsort(fk)[:BRANCH]
+        order = order[np.isfinite(fk[order])]
+        m = self.later_mirror[k]
+        extra = np.zeros(len(order))
+        if len(order) and m >= 0 and assign[parent[m]] >= 0:
+            order, extra = self._mirror_bound(k, m, assign, used, order)
+        if len(order) == 0:
+            self.stuck[k] += 1
+        out = [(float(fk[v] + e), float(g + gk[v]), assign + (int(v),),
+                pending + ((m, float(e)),) if e else pending) for v, e in zip(order, extra)]
+        if template.optional[k]:
+            out.append((g + W_CARRY + h_rest, g + W_CARRY, assign + (-1,), pending))
+        return out
+
+    def _mirror_bound(self, k, m, assign, used, order):
+        """Tighten the bound with the mirror partner ``m`` still to come: its best place
+        given joint ``k``'s at each vertex of ``order``, mirror and separation terms included
+        (exact for a leaf partner). Returns the vertices of ``order`` where it has one and
+        the bound's increase at each."""
+        am = assign[self.parent[m]]
+        base = self.pair[m][am] + self.down[m]
+        extra = np.zeros(len(order))
+        for i, v in enumerate(order):
+            trial = assign + (int(v),) + (-2,) * (m - k - 1)
+            cm = base + self.coupling(m, trial)
+            cm[used] = np.inf
+            cm[v] = np.inf
+            top = np.min(cm)
+            if self.template.optional[m]:
+                top = min(top, W_CARRY)
+            extra[i] = top - self.best[m][am]
+        keep = np.isfinite(extra)
+        return order[keep], extra[keep]
+
+    def result(self, state, expansions):
+        """The :class:`Search` of a complete embedding ``state``."""
+        assign = np.asarray(state[2])
+        parts = np.zeros(self.r)
+        for k in range(self.r):
+            if assign[k] >= 0:
+                parts[k] = self.unary[k][assign[k]] + (
+                    self.pair[k][assign[self.parent[k]], assign[k]] if k else 0.0)
+            elif self.template.optional[k] and (k == 0 or assign[self.parent[k]] >= 0):
+                parts[k] = W_CARRY
+        return Search(assign, state[1], expansions, parts=parts)
+
+    def run(self, progress):
+        """A* from the root's best places; a beam search where it runs out of expansions."""
+        f0 = self.down[0]
+        start = [(float(f0[v]), float(self.unary[0][v]), (int(v),), ())
+                 for v in np.argsort(f0)[:BRANCH] if np.isfinite(f0[v])]
+        heap = list(start)
+        heapq.heapify(heap)
+        expansions = 0
+        while heap:
+            state = heapq.heappop(heap)
+            if len(state[2]) == self.r:
+                return self.result(state, expansions)
+            expansions += 1
+            if expansions % 200 == 0 and progress is not None:
+                progress(min(1.0, expansions / MAX_EXPANSIONS), "search")
+            if expansions > MAX_EXPANSIONS:
+                break
+            for child in self.expand(state):
+                heapq.heappush(heap, child)
+        if heap:
+            # The bound was too loose for A* to finish (a template posed far from the mesh:
+            # arms down against arms out); a beam search keeps going with the same costs.
+            states = start
+            for _ in range(1, self.r):
+                states = heapq.nsmallest(BEAM, (c for st in states for c in self.expand(st)))
+                if not states:
+                    break
+            if states:
+                return self.result(min(states, key=lambda st: st[1]), expansions)
+        return Search(None, np.inf, expansions, failed=int(np.argmax(self.stuck))
+                      if self.stuck.any() else _first_unplaceable(self.best, self.template))
+
+
+def _cost_tables(graph, template, frame, scale, low, hints, unit):
+    """``(unary, pair)``: (R, N) each reduced joint's cost at each graph vertex, and per
+    reduced bone (None for the root) its (N, N) cost from its parent's vertex to its own,
+    the user's hints included (a hinted joint near its hint, a chain through a hinted inner
+    joint). ``low`` (R,) bool: the joints standing on the ground."""
     pts, dist = graph.points, graph.dist
     r = len(template.joints)
-    n = len(pts)
     parent = template.parent
-    children = [np.flatnonzero(parent == k) for k in range(r)]
     rest = template.rest[template.joints]
-    # joints standing on the ground (ankles, hooves): their height is a strong cue
-    low = rest[:, 1] - template.floor < FEET * np.ptp(template.rest[~template.carried, 1])
     unary = np.stack([joint_costs(pts, rest[k, 1], template.floor, frame["floor"],
                                   frame["height"], scale, low[k]) for k in range(r)])
     # An optional branch goes only where the grid resolves the part (spheres of two cells
@@ -139,7 +272,6 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None,
     pair = [None] + [bone_costs(pts, dist, rest[k] - rest[parent[k]], template.chain_length[k],
                                 scale, W_LENGTH * (W_LENGTH_TAIL if template.tail[k] else 1.0))
                      for k in range(1, r)]
-    unit = 0.05 * template.size * scale
     for j, point in (hints or {}).items():
         if j in template.joints:
             unary[int(np.flatnonzero(template.joints == j)[0])] += hint_unary(pts, point, unit)
@@ -150,8 +282,14 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None,
                 pair[k] = pair[k] + hint_pair(pts, point, template.rest[chain[0]],
                                               template.rest[j], template.rest[chain[-1]],
                                               scale)
-    # down[k][v]: exact least tree cost of k's subtree with k at v.
-    # best[k][a]: least cost of k's subtree given its parent at a (carrying included).
+    return unary, pair
+
+
+def _tree_bounds(template, unary, pair, children, n):
+    """``(down, best)``, the tree part's exact cost-to-go by dynamic programming:
+    ``down[k][v]`` the least tree cost of k's subtree with k at v, ``best[k][a]`` the least
+    cost of k's subtree given its parent at a (carrying included)."""
+    r = len(unary)
     down = [None] * r
     best = [None] * r
     for k in range(r - 1, -1, -1):
@@ -160,7 +298,14 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None,
             best[k] = np.min(pair[k] + down[k][None, :], axis=1)
             if template.optional[k]:
                 best[k] = np.minimum(best[k], W_CARRY)
-    sep = _separated_pairs(template)
+    return down, best
+
+
+def _partners(template, low, children, field, pts):
+    """{later joint: [(earlier joint, gap test or None)]} of the reduced leaves that must be
+    apart (:func:`_separated_pairs`); two feet with a ``field`` must have the mesh's outside
+    between them (the test: (N,) bool, the segment from a vertex to each vertex leaves it)."""
+    n = len(pts)
     partner = {}
     foot = low & np.array([len(c) == 0 for c in children])
     gap_cache = {}
@@ -171,102 +316,10 @@ def discrete_embedding(graph, template, frame, scale, progress=None, field=None,
             gap_cache[q] = ~field.segments_inside(np.repeat(pts[q:q + 1], n, axis=0), pts)
         return gap_cache[q]
 
-    for a, b, tree in sep:
+    for a, b, tree in _separated_pairs(template):
         test = gap if field is not None and foot[a] and foot[b] else None
         partner.setdefault(max(a, b), []).append((min(a, b), test))
-
-    later_mirror = np.full(r, -1)
-    for k in range(r):
-        if template.mirror[k] > k:
-            later_mirror[k] = template.mirror[k]
-    stuck = np.zeros(r, dtype=np.int64)
-
-    def expand(state):
-        """The children of a partial embedding (f, g, assign, pending), where pending
-        holds (joint, bound) pairs already added to f for mirror partners to come."""
-        f, g, assign, pending = state
-        k = len(assign)
-        a = assign[parent[k]]
-        own = sum(extra for j, extra in pending if j == k)
-        pending = tuple(p for p in pending if p[0] != k)
-        h_rest = f - g - (best[k][a] if a >= 0 else 0.0) - own
-        if a < 0:  # the parent is carried, so is this joint
-            return [(f - own, g, assign + (-1,), pending)]
-        used = np.array([v for v in assign if v >= 0])
-        gk = pair[k][a] + unary[k] + _coupling(k, assign, pts, dist, template, partner, frame,
-                                               unit)
-        gk[used] = np.inf
-        hk = sum((best[c] for c in children[k]), np.zeros(n))
-        fk = g + gk + hk + h_rest
-        order = np.argsort(fk)[:BRANCH]
-        order = order[np.isfinite(fk[order])]
-        m = later_mirror[k]
-        extra = np.zeros(len(order))
-        if len(order) and m >= 0 and assign[parent[m]] >= 0:
-            # Tighten the bound with the mirror partner still to come: its best place given
-            # this joint's, mirror and separation terms included (exact for a leaf partner).
-            am = assign[parent[m]]
-            base = pair[m][am] + down[m]
-            for i, v in enumerate(order):
-                trial = assign + (int(v),) + (-2,) * (m - k - 1)
-                cm = base + _coupling(m, trial, pts, dist, template, partner, frame, unit)
-                cm[used] = np.inf
-                cm[v] = np.inf
-                top = np.min(cm)
-                if template.optional[m]:
-                    top = min(top, W_CARRY)
-                extra[i] = top - best[m][am]
-            keep = np.isfinite(extra)
-            order, extra = order[keep], extra[keep]
-        if len(order) == 0:
-            stuck[k] += 1
-        out = [(float(fk[v] + e), float(g + gk[v]), assign + (int(v),),
-                pending + ((m, float(e)),) if e else pending) for v, e in zip(order, extra)]
-        if template.optional[k]:
-            out.append((g + W_CARRY + h_rest, g + W_CARRY, assign + (-1,), pending))
-        return out
-
-    def _done(state, expansions):
-        assign = np.asarray(state[2])
-        parts = np.zeros(r)
-        for k in range(r):
-            if assign[k] >= 0:
-                parts[k] = unary[k][assign[k]] + (pair[k][assign[parent[k]], assign[k]]
-                                                  if k else 0.0)
-            elif template.optional[k] and (k == 0 or assign[parent[k]] >= 0):
-                parts[k] = W_CARRY
-        return Search(assign, state[1], expansions, parts=parts)
-
-    f0 = down[0]
-    start = [(float(f0[v]), float(unary[0][v]), (int(v),), ())
-             for v in np.argsort(f0)[:BRANCH] if np.isfinite(f0[v])]
-    heap = list(start)
-    heapq.heapify(heap)
-    expansions = 0
-    while heap:
-        state = heapq.heappop(heap)
-        if len(state[2]) == r:
-            return _done(state, expansions)
-        expansions += 1
-        if expansions % 200 == 0 and progress is not None:
-            progress(min(1.0, expansions / MAX_EXPANSIONS), "search")
-        if expansions > MAX_EXPANSIONS:
-            break
-        for child in expand(state):
-            heapq.heappush(heap, child)
-    if heap:
-        # The bound was too loose for A* to finish (a template posed far from the mesh:
-        # arms down against arms out); a beam search keeps going with the same costs.
-        states = start
-        for _ in range(1, r):
-            states = heapq.nsmallest(BEAM, (c for st in states for c in expand(st)))
-            if not states:
-                break
-        if states:
-            done = min(states, key=lambda st: st[1])
-            return _done(done, expansions)
-    return Search(None, np.inf, expansions, failed=int(np.argmax(stuck)) if stuck.any()
-                  else _first_unplaceable(best, template))
+    return partner
 
 
 def _coupling(k, assign, pts, dist, template, partner, frame, unit):
