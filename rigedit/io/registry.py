@@ -9,6 +9,7 @@ of clip names. A new format is one reader, one writer and one line of :data:`FOR
 ``gltf``    ``.glb``, ``.gltf``   :mod:`rigedit.io.gltf_read`, :mod:`rigedit.io.gltf_write`
 ``bvh``     ``.bvh``              :mod:`rigedit.io.bvh`, :mod:`rigedit.io.bvh_write`: a
                                   skeleton and one clip, no mesh
+``fbx``     ``.fbx``              :mod:`rigedit.io.fbx_read` (through ufbx)
 ==========  ====================  =================================================
 """
 from __future__ import annotations
@@ -20,6 +21,7 @@ from typing import Callable, Tuple
 from ..errors import RigFileError
 from .bvh import read_bvh
 from .bvh_write import write_bvh
+from .fbx_read import read_fbx
 from .gltf_read import read_gltf
 from .gltf_write import save_gltf
 from .paths import what_is
@@ -44,7 +46,14 @@ FORMATS = (
     Format("folder", (), read_rig_folder, write_rig_folder),
     Format("gltf", (".glb", ".gltf"), read_gltf, save_gltf),
     Format("bvh", (".bvh",), read_bvh, write_bvh, options=("scale",)),
+    Format("fbx", (".fbx",), read_fbx, lambda data, path, clips=None: _no_fbx_writer(path)),
 )
+
+
+def _no_fbx_writer(path):
+    # until rigedit/io/fbx_write.py (issue 19, section 2) takes this place
+    raise RigFileError(path, "expected a .glb, .gltf, .bvh file or a folder to write; FBX "
+                             "writing is not available yet")
 
 #: File suffixes that hold a whole rig (besides folders and bundled names).
 RIG_FILE_SUFFIXES = tuple(s for f in FORMATS for s in f.suffixes)

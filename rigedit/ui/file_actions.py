@@ -191,7 +191,7 @@ class FileActions:
         if check is None:
             return None
         path = path or self._ask_open("Open glTF or BVH file",
-                                      "Rigs and motion (*.glb *.gltf *.bvh)")
+                                      "Rigs and motion (*.glb *.gltf *.fbx *.bvh)")
         if not path:
             return None
         return self._run(f"Opening {Path(path).name}", lambda report: _load_file(path),
