@@ -37,6 +37,7 @@ from .import_motion import ImportMotion
 from .jobs import JobRunner
 from .menus import build_menus
 from .messages import Messages
+from .morph_panel import MorphDock
 from .panels import PANEL_PLAYBACK_MS, Panels  # noqa: F401 - PANEL_PLAYBACK_MS: old home
 from .proxy_view import ProxyView
 from .rebind import RestRebind
@@ -167,11 +168,12 @@ class MainWindow(QtWidgets.QMainWindow):
         self.setCorner(QtCore.Qt.BottomRightCorner, QtCore.Qt.RightDockWidgetArea)
         self.timeline = TimelineDock(self)
         self.addDockWidget(QtCore.Qt.BottomDockWidgetArea, self.timeline)
+        self.morph_dock = MorphDock(self, self.document, self.status)   # right, under Info
 
     def _build_menus(self):
         parts = (self.files, self.autorig, self.reembed, self.motion_import, self.recorder,
                  self.edit, self.view_actions, self.panels, self.weight_brush,
-                 self.weight_tools)
+                 self.weight_tools, self.morph_dock)
         actions = {"timeline_dock": self.timeline.toggleViewAction()}
         for part in parts:
             actions.update(part.actions())

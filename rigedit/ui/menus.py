@@ -30,7 +30,7 @@ MENUS = (
     ("&View", (("solid", "translucent", "wireframe"),
                ("skeleton", "gizmos", "weights", "weight_brush", "dqs", "floor"),
                ("front", "side", "top", "back", "reset_camera"),
-               ("joints_dock", "info_dock", "timeline_dock"))),
+               ("joints_dock", "info_dock", "shapes_dock", "timeline_dock"))),
 )
 
 #: The "Tools" tool bar: action or widget names, :class:`Label` texts, None for a separator.
