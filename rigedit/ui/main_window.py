@@ -24,6 +24,7 @@ import functools
 
 from PyQt5 import QtCore, QtWidgets
 
+from ..editor import events as ev
 from ..editor.document import Document
 from ..editor.drag import DragSettings
 from . import errors_hook
@@ -141,8 +142,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self.reembed = ReembedAction(d, services)
         self.motion_import = ImportMotion(d, services, self.timeline.clip_manager.add_clip)
         self.recorder = RecordVideo(d, view, services)
-        d.subscribe(self._on_document)   # after the timeline's (it samples the clip first)
-        self._on_document("rig")
+        d.listen(self._on_event)   # after the timeline (it samples the clip first)
+        self._on_event(ev.RigReplaced())
         # parts that draw into (or listen to) the scene come once it is built
         self.weight_brush = WeightBrush(d, view, BrushPanel(), self.panels.info_panel,
                                         services, self.set_weights_view)
@@ -189,28 +190,30 @@ class MainWindow(QtWidgets.QMainWindow):
         self.progress, self.cancel_button = self.jobs.progress, self.jobs.cancel_button
 
     # ================================================================== document events
-    def _on_document(self, event, **info):
+    def _on_event(self, event):
+        """A document event (:mod:`rigedit.editor.events`): the view first, then the docks,
+        the Edit menu and the title."""
         d, view = self.document, self.scene_view
-        if event == "rig":
+        if isinstance(event, ev.RigReplaced):
             view.load()
             self.view_actions.rig_loaded()
-        elif event == "pose":
+        elif isinstance(event, ev.PoseChanged):
             view.refresh_pose()
-        elif event == "rest":
+        elif isinstance(event, (ev.RestChanged, ev.WeightsChanged)):
             view.show_rest_change()
-        elif event == "selection":
-            view.show_selection(info.get("joint"))
-        elif event == "mode":
+        elif isinstance(event, ev.SelectionChanged):
+            view.show_selection(event.joint)
+            if event.joint is not None:
+                self.status(f"Selected {d.skeleton.names[event.joint]}")
+        elif isinstance(event, ev.ModeChanged):
             self.view_actions.mode_changed()
-        self.panels.on_document(event, **info)
-        if event in ("rig", "undo"):
+        self.panels.on_event(event)
+        if isinstance(event, (ev.RigReplaced, ev.UndoChanged)):
             self.edit.update()
             self._update_title()
-        if event == "selection" and info.get("joint") is not None:
-            self.status(f"Selected {d.skeleton.names[info['joint']]}")
-        if event in ("pose", "selection"):
+        if isinstance(event, (ev.PoseChanged, ev.SelectionChanged)):
             view.request_render()
-        elif event == "rig":
+        elif isinstance(event, ev.RigReplaced):
             self.plotter.update()
 
     def _update_title(self):

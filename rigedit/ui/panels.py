@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from PyQt5 import QtCore, QtWidgets
 
+from ..editor import events as ev
 from .joint_panel import InfoPanel, JointPanel
 
 __all__ = ["Panels", "PANEL_PLAYBACK_MS"]
@@ -72,22 +73,22 @@ class Panels:
                 "info_dock": self.info_dock.toggleViewAction()}
 
     # ------------------------------------------------------------------ document events
-    def on_document(self, event, **info):
+    def on_event(self, event):
+        """Follow a document event (:mod:`rigedit.editor.events`)."""
         d = self.document
-        if event == "rig":
+        if isinstance(event, ev.RigReplaced):
             self.joint_panel.set_skeleton(d.rig.skeleton)
             self.info_panel.show_rig(d.rig)
             self.info_panel.show_selection(d.rig, None)
-        elif event == "pose":
+        elif isinstance(event, ev.PoseChanged):
             if not d.dragging or not self.interacting():
                 self.show_joint_values()
-        elif event == "rest":
+        elif isinstance(event, (ev.RestChanged, ev.WeightsChanged)):
             self.info_panel.show_rig(d.rig)
-        elif event == "selection":
-            j = info.get("joint")
-            self.joint_panel.show_joint(j, d.pose)
-            self.info_panel.show_selection(d.rig, j)
-        elif event == "clip":   # clips added, removed or renamed: the Info count follows
+        elif isinstance(event, ev.SelectionChanged):
+            self.joint_panel.show_joint(event.joint, d.pose)
+            self.info_panel.show_selection(d.rig, event.joint)
+        elif isinstance(event, ev.ClipChanged):   # clips added, removed or renamed
             self.info_panel.labels["Clips"].setText(str(len(d.clips)))
 
     def show_joint_values(self):
