@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .skinning_kernels import DQS_TASK, FASTMATH
+from .kernel_settings import DQS_TASK, FASTMATH
 from .skinning_simd import dq_apply16 as _dq_apply16
 from .skinning_simd import dq_apply16_normals as _dq_apply16_normals
 from .skinning_simd import dq_blend4_into as _dq_blend4_into

@@ -42,13 +42,7 @@ __all__ = ["ready", "load", "start_loading", "disabled", "error", "Kernels", "DI
 AUTO_LOAD_MIN_VERTICES = 50_000
 
 DISABLE_ENV = "RIGEDIT_NO_NUMBA"
-# Reassociation and FMA contraction let LLVM vectorise the blends; no "fast" flags that
-# assume finite values or approximate divisions and square roots.
-FASTMATH = {"contract", "reassoc", "nsz", "arcp"}
-
-#: Vertices per parallel task of the DQS kernel (a multiple of skinning_simd.DQ_BLOCK): each
-#: task allocates its small scratch blocks once.
-DQS_TASK = 1024
+from .kernel_settings import DQS_TASK, FASTMATH  # noqa: E402  (shared with dqs_kernels)
 
 
 def hemisphere_signs(dq, out):
