@@ -94,6 +94,9 @@ def check_claims(data, path):
             if record_end == 0:                     # the null record closing a list
                 p = stack.pop()
                 continue
+            if record_end > len(data):
+                raise RigFileError(path, "expected a valid FBX file, got one that is cut "
+                                         "short (a record ends past the end of the file)")
             if not p < record_end <= end:
                 raise RigFileError(path, "expected a valid FBX file, got a record that runs "
                                          "past its parent")

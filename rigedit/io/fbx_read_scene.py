@@ -16,6 +16,7 @@ Two things about the ``ufbx`` Python binding (0.0.5) shape this module:
 """
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -148,15 +149,24 @@ def open_scene(path):
     try:
         raw = ufbx.load_memory(data, **_options(path))
     except ufbx.UfbxError as exc:
-        text = str(exc).strip()
-        message = text.splitlines()[0] if text else type(exc).__name__
         raise RigFileError(path, f"expected a valid FBX file, got one ufbx cannot read "
-                                 f"({message})") from None
+                                 f"({_ufbx_problem(exc)})") from None
     except (MemoryError, OverflowError) as exc:
         raise RigFileError(path, f"expected an FBX file rigedit can hold in memory, got "
                                  f"one that does not fit ({type(exc).__name__})") from None
     keep = [raw]
     return Held(raw, keep), keep
+
+
+def _ufbx_problem(exc):
+    """A phrase for a ufbx error: its kind (``TruncatedFileError`` -> "truncated file"),
+    and its text where that says more than "Failed to load"."""
+    kind = type(exc).__name__.removesuffix("Error")
+    words = re.sub(r"(?<!^)(?=[A-Z])", " ", kind).lower()
+    text = (str(exc).strip().splitlines() or [""])[0]
+    if not text or text.lower() in ("failed to load", words):
+        return words if kind not in ("Unknown", "Ufbx") else "failed to load"
+    return f"{words}: {text}" if kind not in ("Unknown", "Ufbx") else text
 
 
 def axes_text(axes):
