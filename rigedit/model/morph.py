@@ -217,7 +217,17 @@ class MorphedRest:
         self.weights = np.zeros(morphs.count)   # the weights in the buffers
         self.points, self.normals = rest, None  # what a skinning pass reads now
         self._buf = self._nbuf = None
-        self._dirty = np.zeros(0, dtype=np.int64)  # rows of the buffers that differ from rest
+        # the targets whose rows the buffers hold displaced: they go back to rest first
+        self._dirty = set()
+        # Each target's rows as an index into the buffers seen flat, (3V,): a slice when it
+        # moves every vertex, else the 3n flat positions of its rows. The reset and
+        # multiply-add of 30k rows measured 0.10 ms by slice, 3.2 ms by row index (an (n,)
+        # index into a (V, 3) array); of 15k rows 0.4 ms by flat index, 1.5 ms by row index.
+        v = len(rest)
+        self._index = [slice(None) if len(r) == v else (3 * r[:, None] + np.arange(3)).ravel()
+                       for r in (morphs.moved_rows(m) for m in range(morphs.count))]
+        self._moves = np.array([len(morphs.moved_rows(m)) > 0 for m in range(morphs.count)],
+                               dtype=bool)
 
     def bind_normals(self, rest_normals):
         """Use ``rest_normals`` (V, 3) float32 from now on (the weights re-applied)."""
@@ -234,32 +244,35 @@ class MorphedRest:
         if np.array_equal(w, self.weights):
             return False
         self.weights = w
-        active = mt.active(w)
+        active = np.flatnonzero((w != 0) & self._moves)
         if not len(active):
             self.points, self.normals = self.rest, self.rest_normals
             return True
-        if self._buf is None:
-            self._buf, self._dirty = self.rest.copy(), np.zeros(0, dtype=np.int64)
         with_normals = self.rest_normals is not None and mt.normal_deltas is not None
+        if self._buf is None:
+            self._buf = self.rest.copy()
         if with_normals and self._nbuf is None:
             self._nbuf = self.rest_normals.copy()
-            self._nbuf_dirty = np.zeros(0, dtype=np.int64)
-        rows = np.unique(np.concatenate([mt.moved_rows(m) for m in active]))
-        self._reset(self._buf, self.rest, np.union1d(self._dirty, rows))
-        if with_normals:
-            self._reset(self._nbuf, self.rest_normals, np.union1d(self._nbuf_dirty, rows))
-            self._nbuf_dirty = rows
-        for m in active:
-            r, d, n = mt.sparse_target(m)
-            # rows are unique within one target: the fancy-index add is exact
-            self._buf[r] += np.float32(w[m]) * d
+            self._dirty = set(range(mt.count))   # a new normals buffer: all rows again
+        # Back to rest: the rows of the targets displaced before and of those active now
+        # (rows shared by two targets are reset twice, harmlessly), then each target's sum.
+        # No union of rows is formed: np.unique over 30k rows took 7 ms.
+        buf, rest = self._buf.reshape(-1), self.rest.reshape(-1)
+        nbuf = self._nbuf.reshape(-1) if with_normals else None
+        nrest = self.rest_normals.reshape(-1) if with_normals else None
+        for m in self._dirty | set(active.tolist()):
+            i = self._index[m]
+            buf[i] = rest[i]
             if with_normals:
-                self._nbuf[r] += np.float32(w[m]) * n
-        self._dirty = rows
+                nbuf[i] = nrest[i]
+        for m in active:
+            i = self._index[m]
+            _, d, n = mt.sparse_target(m)
+            # positions are unique within one target: the fancy-index add is exact
+            buf[i] += np.float32(w[m]) * d.reshape(-1)
+            if with_normals:
+                nbuf[i] += np.float32(w[m]) * n.reshape(-1)
+        self._dirty = set(active.tolist())
         self.points = self._buf
         self.normals = self._nbuf if with_normals else self.rest_normals
         return True
-
-    @staticmethod
-    def _reset(buf, rest, rows):
-        buf[rows] = rest[rows]

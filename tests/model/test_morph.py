@@ -186,3 +186,28 @@ def test_targets_of_another_vertex_count_are_refused():
     with pytest.raises(ValueError, match="vertices"):
         Rig(sk, v, f, np.zeros((len(v), 1), int), np.ones((len(v), 1)),
             morphs=MorphTargets(("a",), np.zeros((1, 5, 3))))
+
+
+def test_a_sequence_of_weights_on_overlapping_targets_always_gives_rest_plus_the_sum():
+    rng = np.random.default_rng(5)
+    V = 50
+    deltas = np.zeros((3, V, 3), np.float32)
+    deltas[0, :30] = rng.normal(size=(30, 3))
+    deltas[1, 20:] = rng.normal(size=(30, 3))            # overlaps target 0 on rows 20..29
+    deltas[2] = rng.normal(size=(V, 3))                   # every row (the slice path)
+    ndeltas = rng.normal(size=(3, V, 3)).astype(np.float32) * (deltas != 0)
+    mt = MorphTargets(("a", "b", "c"), deltas, ndeltas)
+    rest = rng.normal(size=(V, 3)).astype(np.float32)
+    normals = rng.normal(size=(V, 3)).astype(np.float32)
+    from rigedit.model.morph import MorphedRest
+    mr = MorphedRest(mt, rest)
+    for step in range(40):
+        w = rng.choice([0.0, 0.0, 0.3, -1.2, 1.0], size=3)
+        if step == 10:
+            mr.bind_normals(normals)
+        mr.set_weights(w)
+        np.testing.assert_allclose(mr.points, rest + np.tensordot(w, deltas, 1), atol=1e-5)
+        if step >= 10:
+            np.testing.assert_allclose(mr.normals, normals + np.tensordot(w, ndeltas, 1),
+                                       atol=1e-5)
+    np.testing.assert_array_equal(rest, mr.rest)          # the rest itself never written
