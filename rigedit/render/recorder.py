@@ -129,6 +129,7 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         clip = clip.copy()   # the editor may change its clip while we render
 
     after_frame = _frame_callback(progress)
+    shown_weights = rig.binding.morph_weights
     _use_egl_without_display()
     plotter = pv.Plotter(off_screen=True, window_size=(width, height))
     writer = None
@@ -147,6 +148,7 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
             scene.view(view, angle, points=swept_points(rig, clip, times))
         if clip is not None:
             clip.sample(times[0], out=pose)
+            rig.binding.set_morph_weights(clip.sample_morphs(times[0]))
         model0 = scene.update(pose)
         base_pos = np.array(plotter.camera.position)
         base_focal = np.array(plotter.camera.focal_point)
@@ -162,6 +164,8 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         for i, t in enumerate(times):
             if clip is not None:
                 clip.sample(t, out=pose)
+                # the clip's morph weights (the editor's are put back at the end)
+                rig.binding.set_morph_weights(clip.sample_morphs(t))
             model = scene.update(pose)
             shift = horizontal(model[follow, :3, 3] - root0, up) if follow_root else \
                 np.zeros(3)
@@ -180,6 +184,7 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         writer = None
         return len(times)
     finally:
+        rig.binding.set_morph_weights(shown_weights)
         if writer is not None:
             writer.abort()
         plotter.close()
