@@ -72,10 +72,11 @@ def faces_to_vtk(faces):
 
 
 def _copy_influences(binding, points, source):
-    """A SkinBinding of ``points`` (P, 3) with the influences of ``binding``'s vertices
-    ``source`` (P,)."""
+    """A SkinBinding of ``points`` (P, 3) with the influences (and morph targets) of
+    ``binding``'s vertices ``source`` (P,)."""
+    morphs = None if binding.morphs is None else binding.morphs.subset(source)
     return SkinBinding(points, binding.indices[source], binding.weights[source],
-                       binding.num_joints)
+                       binding.num_joints, morphs=morphs)
 
 
 def _decimate(vertices, faces, target_faces):
@@ -186,8 +187,11 @@ class ProxyActor:
     def set_visible(self, on):
         self.actor.SetVisibility(bool(on))
 
-    def skin(self, palette, method="lbs"):
-        """Skin the proxy with ``palette`` (J, 4, 4) into its actor's points and normals."""
+    def skin(self, palette, method="lbs", morph_weights=None):
+        """Skin the proxy with ``palette`` (J, 4, 4) into its actor's points and normals,
+        with the full mesh's ``morph_weights`` (M,) when it has morph targets."""
+        if morph_weights is not None:
+            self.proxy.binding.set_morph_weights(morph_weights)
         write_skin(self.mesh, *self.proxy.binding.skin_with_normals(palette, method=method))
 
     def remove(self):

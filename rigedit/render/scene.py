@@ -283,7 +283,8 @@ class RigScene:
         if not self.has_mesh:
             self.bare_skeleton.update(model)
         elif skin and self.proxy_shown:
-            self.proxy_actor.skin(skinning_matrices(self.rig.skeleton, model), self.skinning)
+            self.proxy_actor.skin(skinning_matrices(self.rig.skeleton, model), self.skinning,
+                                  self.rig.binding.morph_weights)
         elif skin:
             palette = skinning_matrices(self.rig.skeleton, model)
             if self.skinned_normals:
