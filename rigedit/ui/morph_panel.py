@@ -107,6 +107,9 @@ class MorphPanel(QtWidgets.QWidget):
         self.rows = {name: _Row(self, grid, i, name) for i, name in enumerate(names)}
         grid.setRowStretch(len(names), 1)
         self.scroll.setWidget(body)
+        # up to four rows without scrolling, however the right-hand docks share the height
+        row = body.sizeHint().height() / max(len(names), 1)
+        self.scroll.setMinimumHeight(int(min(len(names), 4) * row))
         self.empty.setVisible(not names)
         self.scroll.setVisible(bool(names))
         self.refresh()
