@@ -18,8 +18,9 @@ What is read
   ``target_unit_meters`` and ``target_axes``, applied to the geometry and transforms
   themselves); ``meta.notes["units"]`` and ``["frames"]`` say what the file had.
 
-Vertices a skin leaves without weight follow the node holding their mesh (as FBX skinning
-does): that node then becomes a joint. Blend shapes are not read (a warning says so).
+Blend shapes become morph targets with their channels' weight curves as weight tracks
+(:mod:`rigedit.io.fbx_read_shapes`). Vertices a skin leaves without weight follow the node
+holding their mesh (as FBX skinning does): that node then becomes a joint.
 """
 from __future__ import annotations
 
@@ -227,10 +228,7 @@ def _read(scene, keep, path):
     moved = animated_nodes(stacks, {i: nodes.rest(i) for i in range(len(nodes.names))})
     skeleton, joint_of, prefix = _skeleton(path, nodes, mesh, moved)
     indices, weights = _influences(mesh, joint_of, path) if len(mesh.vertices) else (None, None)
-    clips, shifts = clips_of(stacks, skeleton, joint_of, prefix)
-    if any(m.blend_deformers for m in scene.meshes):
-        warnings.warn(f"{path}: ignored blend shapes (not read from FBX yet; the base shape "
-                      "is used)", FbxWarning, stacklevel=3)
+    clips, shifts = clips_of(stacks, skeleton, joint_of, prefix, mesh.channels)
     notes, unit = _notes(settings)
     notes["frames"] += f"; clips baked at {fps:g} frames per second"
     if shifts:
@@ -239,4 +237,5 @@ def _read(scene, keep, path):
     return RigData(skeleton, mesh.vertices, mesh.faces, indices, weights, clips,
                    surface=mesh.surface if len(mesh.vertices) else None, name=path.stem,
                    up="y", meta=RigMeta(source=path, format="fbx", units="metres",
-                                        scale=unit if unit > 0 else None, notes=notes))
+                                        scale=unit if unit > 0 else None, notes=notes),
+                   morphs=mesh.morphs)

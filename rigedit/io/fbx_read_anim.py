@@ -13,10 +13,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..animation.clip import Clip, Track
+from ..animation.morph_track import WeightTrack
 from .fbx_read_scene import call, ufbx_module
 from .gltf_anim import clip_names, quat_left_matrix
 
-__all__ = ["bake_stacks", "animated_nodes", "clips_of", "reduce_keys", "EXACT"]
+__all__ = ["bake_stacks", "animated_nodes", "clips_of", "weight_tracks", "reduce_keys",
+           "EXACT"]
 
 #: A key is dropped when its neighbours' interpolation gives it within this (file units
 #: after conversion: metres, unit quaternion components, scale factors).
@@ -28,7 +30,7 @@ def _interpolate(channel, a, b, u):
     rotations the slerp of :func:`rigedit.animation.interpolate.slerp` row by row (``b`` on
     ``a``'s hemisphere already)."""
     u = u[:, None]
-    if channel != "rotation":
+    if channel != "rotation":   # translation, scale, a morph target's weight
         return a + (b - a) * u
     dot = np.clip(np.sum(a * b, axis=1, keepdims=True), -1.0, 1.0)
     theta = np.arccos(dot)
@@ -139,8 +141,9 @@ def _track(channel, times, values, prefix, shift):
 
 
 def bake_stacks(scene, keep, fps):
-    """Every animation stack baked by ufbx: a list of ``(name, begin, end, nodes)`` with
-    ``nodes`` node typed id -> channel -> ((K,) times, (K, C) local values).
+    """Every animation stack baked by ufbx: a list of ``(name, begin, end, nodes,
+    elements)`` with ``nodes`` node typed id -> channel -> ((K,) times, (K, C) local values)
+    and ``elements`` element id -> animated property -> ((K,) times, (K,) first components).
 
     Parameters
     ----------
@@ -164,8 +167,13 @@ def bake_stacks(scene, keep, fps):
                 for channel, keys in (("translation", baked.translation_keys),
                                       ("rotation", baked.rotation_keys),
                                       ("scale", baked.scale_keys)) if len(keys)}
+        elements = {}
+        for baked in bake.elements:     # blend shape channels' weights (DeformPercent)
+            elements[baked.element_id] = {
+                prop.name: tuple(a[:, 0] if a.ndim == 2 else a for a in _keys(prop.keys, 3))
+                for prop in baked.props if len(prop.keys)}
         begin = min(float(stack.time_begin), float(bake.key_time_min))
-        out.append((name, begin, float(stack.time_end), nodes))
+        out.append((name, begin, float(stack.time_end), nodes, elements))
     return out
 
 
@@ -173,7 +181,7 @@ def animated_nodes(stacks, rest):
     """Typed ids of the nodes some stack moves away from their rest ``rest`` (typed id ->
     {channel: (C,) value})."""
     moved = set()
-    for _name, _begin, _end, nodes in stacks:
+    for _name, _begin, _end, nodes, _elements in stacks:
         for node, channels in nodes.items():
             for channel, (_times, values) in channels.items():
                 ref = rest[node][channel]
@@ -184,7 +192,7 @@ def animated_nodes(stacks, rest):
     return moved
 
 
-def clips_of(stacks, skeleton, joint_of_node, prefix):
+def clips_of(stacks, skeleton, joint_of_node, prefix, channels=None):
     """The baked stacks as clips on ``skeleton``.
 
     Parameters
@@ -196,6 +204,8 @@ def clips_of(stacks, skeleton, joint_of_node, prefix):
         Node typed id -> joint index.
     prefix : list
         Per joint, the (4, 4) folded similarity of non-joint ancestors, or None.
+    channels : dict[str, list[int]], optional
+        Morph target name -> element ids of its blend shape channels (weight tracks).
 
     Returns
     -------
@@ -205,18 +215,45 @@ def clips_of(stacks, skeleton, joint_of_node, prefix):
         no key has a negative time); the file's times elsewhere.
     """
     clips, shifts = {}, {}
-    for name, begin, end, nodes in stacks:
+    for name, begin, end, nodes, elements in stacks:
         shift = max(0.0, -begin)
         if shift:
             shifts[name] = shift
         tracks = {}
-        for node, channels in nodes.items():
+        for node, keyed in nodes.items():
             j = joint_of_node.get(node)
             if j is None:
                 continue
-            for channel, (times, values) in channels.items():
+            for channel, (times, values) in keyed.items():
                 tracks[(skeleton.names[j], channel)] = _track(channel, times, values,
                                                               prefix[j], shift)
-        last = max((tr.times[-1] for tr in tracks.values()), default=0.0)
-        clips[name] = Clip(name, skeleton, tracks, duration=max(end + shift, last), loop=True)
+        morph = weight_tracks(elements, channels or {}, shift)
+        last = max((tr.times[-1] for tr in [*tracks.values(), *morph.values()]), default=0.0)
+        clips[name] = Clip(name, skeleton, tracks, duration=max(end + shift, last), loop=True,
+                           morph_tracks=morph)
     return clips, shifts
+
+
+def weight_tracks(elements, channels, shift):
+    """Weight tracks of one baked stack: target name -> :class:`WeightTrack` (the first of
+    its channels that the stack animates), keys reduced where exact.
+
+    Parameters
+    ----------
+    elements : dict[int, dict[str, ((K,) times, (K,) values)]]
+        Baked element id -> property name -> keys (``DeformPercent``, 0..100).
+    channels : dict[str, list[int]]
+    shift : float
+        Seconds added to every key time.
+    """
+    tracks = {}
+    for name, ids in channels.items():
+        keys = next((elements[e]["DeformPercent"] for e in ids
+                     if "DeformPercent" in elements.get(e, {})), None)
+        if keys is None:
+            continue
+        times, values = keys
+        values = values / 100.0
+        keep = reduce_keys("weight", times, values[:, None])
+        tracks[name] = WeightTrack(times[keep] + shift, values[keep], "LINEAR")
+    return tracks

@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import RigFileError
 from ..surface import Material, Surface
 from .fbx_read_scene import matrix_of
+from .fbx_read_shapes import merge_shapes, mesh_shapes
 from .gltf_mesh import decode_image
 from .paths import read_bytes
 
@@ -34,8 +35,10 @@ MAX_INFLUENCES = 8
 class SkinnedMeshes:
     """The merged mesh: ``vertices`` (V, 3), ``faces`` (F, 3) int64, ``bones`` (V, K) typed
     ids of the bone nodes, ``weights`` (V, K) (zero where a vertex has fewer), ``surface``,
-    ``inverse_bind`` (bone node typed id -> (4, 4)), ``unweighted`` (V,) bool and, per
-    vertex, ``mesh_node`` (the typed id of the node holding its mesh)."""
+    ``inverse_bind`` (bone node typed id -> (4, 4)), ``unweighted`` (V,) bool, per
+    vertex ``mesh_node`` (the typed id of the node holding its mesh), ``morphs``
+    (:class:`~rigedit.model.morph.MorphTargets` of the blend shapes, or None) and
+    ``channels`` (target name -> element ids of its blend shape channels)."""
 
     vertices: np.ndarray
     faces: np.ndarray
@@ -45,6 +48,8 @@ class SkinnedMeshes:
     inverse_bind: dict = field(default_factory=dict)
     unweighted: np.ndarray = None
     mesh_node: np.ndarray = None
+    morphs: object = None
+    channels: dict = field(default_factory=dict)
 
 
 def triangulate(face_begin, face_count, corner_pos):
@@ -129,7 +134,7 @@ def _inverse_binds(skin, m, inverse_bind, conflicts):
             inverse_bind[key] = ibm
 
 
-def _mesh_parts(mesh, node, path, part_offset, material_index):
+def _mesh_parts(mesh, node, path, part_offset, material_index, warning):
     """One skinned mesh: per-vertex arrays (after splitting corners by normal, UV and part)
     and its triangles."""
     skin = mesh.skin_deformers[0]
@@ -168,7 +173,7 @@ def _mesh_parts(mesh, node, path, part_offset, material_index):
                                                               1.0 - uvs[first, 1]]),
                 part=part_of + part_offset, part_material=[mats[min(i, len(mats) - 1)]
                                                            for i in range(max(len(mats), 1))],
-                m=m, skin=skin)
+                m=m, skin=skin, shapes=mesh_shapes(mesh, m, vp, path, warning))
 
 
 def _rotate_normals(normals, m):
@@ -201,7 +206,7 @@ def read_skinned_meshes(scene, path, warning):
             unskinned.append(mesh.name)
             continue
         node = mesh.instances[0]
-        p = _mesh_parts(mesh, node, path, part_offset, material_index)
+        p = _mesh_parts(mesh, node, path, part_offset, material_index, warning)
         _inverse_binds(p["skin"], p["m"], inverse_bind, conflicts)
         p["faces"] = p["faces"] + offset
         p["mesh_node"] = np.full(len(p["vertices"]), node.typed_id, np.int64)
@@ -243,10 +248,12 @@ def _merge(parts, inverse_bind, materials, part_material):
     surface = Surface(normals, uvs, np.concatenate([p["part"] for p in parts]),
                       np.array(part_material, dtype=np.int64), materials)
     unweighted = weights.sum(axis=1) <= 0
+    offsets = np.cumsum([0] + [len(p["vertices"]) for p in parts])
+    morphs, channels = merge_shapes([p["shapes"] for p in parts], offsets[:-1], offsets[-1])
     return SkinnedMeshes(np.concatenate([p["vertices"] for p in parts]),
                          np.concatenate([p["faces"] for p in parts]).reshape(-1, 3),
                          bones, weights, surface, inverse_bind, unweighted,
-                         np.concatenate([p["mesh_node"] for p in parts]))
+                         np.concatenate([p["mesh_node"] for p in parts]), morphs, channels)
 
 
 def _material(mt, path, warning):

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
+from fbx_mini import mini_fbx
 from rigedit.cli.main import main
 from rigedit.errors import RigFileError
 from rigedit.io.fbx_read import read_fbx
@@ -163,6 +164,51 @@ def test_key_reduction_is_exact():
         assert np.abs(again - values).max() <= 1e-9
     line = np.linspace(0, 1, 30)[:, None] * np.ones((1, 3))
     assert list(reduce_keys("translation", np.linspace(0, 1, 30), line)) == [0, 29]
+
+
+
+def test_blend_shape_is_a_morph_target_with_its_weight_curve(tmp_path):
+    path = tmp_path / "quad.fbx"
+    path.write_text(mini_fbx([(0.0, 0.0), (0.5, 100.0), (1.0, 40.0)]))
+    data = read_fbx(path)
+    morphs = data.morphs
+    assert morphs.names == ("Raise",) and np.allclose(morphs.default_weights, [0.25])
+    clip = data.clips["Take 001"]
+    track = clip.morph_tracks["Raise"]
+    assert np.allclose(track.times, [0, 0.5, 1]) and np.allclose(track.values, [0, 1, 0.4])
+    rig = Rig.from_data(data)
+    corners = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+    lift = np.array([[0, 0, 0], [0, 0, 0], [0, 0, 0.5], [0, 0, 0.5]])
+    for t, w in [(0.0, 0.0), (0.25, 0.5), (0.5, 1.0), (0.75, 0.7), (1.0, 0.4)]:
+        weights = clip.sample_morphs(t)
+        assert abs(weights["Raise"] - w) < 1e-9
+        posed = rig.skin(clip.sample(t), morph_weights=weights)
+        # each vertex (split or not) is a corner plus w times its offset, in metres
+        expected = corners + w * lift
+        assert cKDTree(expected).query(posed)[0].max() < 1e-6
+        assert cKDTree(posed).query(expected)[0].max() < 1e-6
+
+
+def _png(path):
+    import imageio.v3 as iio
+    iio.imwrite(path, np.full((4, 4, 3), [10, 200, 30], np.uint8))
+
+
+def test_texture_beside_the_file_is_read_and_outside_it_is_not(tmp_path):
+    folder = tmp_path / "asset"
+    folder.mkdir()
+    _png(folder / "skin.png")
+    _png(tmp_path / "secret.png")
+    inside = folder / "in.fbx"
+    inside.write_text(mini_fbx([(0.0, 0.0), (1.0, 0.0)], texture="skin.png"))
+    [material] = read_fbx(inside).surface.materials
+    assert material.texture is not None and tuple(material.texture[0, 0]) == (10, 200, 30, 255)
+    for name in ("../secret.png", str(tmp_path / "secret.png")):
+        outside = folder / "out.fbx"
+        outside.write_text(mini_fbx([(0.0, 0.0), (1.0, 0.0)], texture=name))
+        with pytest.warns(UserWarning, match="neither embedded nor in the file's folder"):
+            [material] = read_fbx(outside).surface.materials
+        assert material.texture is None and material.image_bytes is None
 
 
 def _binary(tmp_path, mutate, name):
