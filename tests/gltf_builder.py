@@ -49,6 +49,25 @@ class GltfBuilder:
         self.doc["accessors"].append(acc)
         return len(self.doc["accessors"]) - 1
 
+    def accessor_data(self, index):
+        """(N, C) float64 values of a tightly packed accessor added by :meth:`accessor`."""
+        acc = self.doc["accessors"][index]
+        view = self.doc["bufferViews"][acc["bufferView"]]
+        dtype = {v: k for k, v in CTYPES.items()}[acc["componentType"]]
+        width = {v: k for k, v in TYPES.items()}[acc["type"]]
+        start = view["byteOffset"] + acc.get("byteOffset", 0)
+        raw = np.frombuffer(bytes(self.bin[start:start + acc["count"] * width * dtype.itemsize]),
+                            dtype=dtype)
+        return raw.reshape(acc["count"], width).astype(np.float64)
+
+    def replace_accessor(self, index, array):
+        """Point accessor ``index`` at new values (a view of its own), min/max updated."""
+        arr = np.asarray(array).reshape(len(array), -1).astype(np.float32)
+        acc = self.doc["accessors"][index]
+        acc.update(bufferView=self.view(arr.tobytes()), byteOffset=0, count=len(arr))
+        if "min" in acc:
+            acc.update(min=arr.min(0).tolist(), max=arr.max(0).tolist())
+
     def interleaved(self, arrays, dtypes):
         """Accessors for several (N, C) arrays interleaved in one strided view."""
         parts = [np.asarray(a).reshape(len(a), -1).astype(d) for a, d in zip(arrays, dtypes)]
@@ -233,3 +252,96 @@ def two_bone(ancestor=None, names=("root", "tip"), mode=4, **options):
          "interpolation": interp}],
         "channels": [{"sampler": 0, "target": {"node": j1, "path": "rotation"}}]}]
     return b, {"positions": pos, "faces": faces, "weights": wt[:, :2]}
+
+
+def _bar_primitive(b, origin, joints, rows=4, height=0.4, skinned=True, targets=None):
+    """A bar of ``2 * rows`` vertices going up from ``origin``: weights blend from
+    ``joints[0]`` at the bottom to ``joints[1]`` at the top (one joint: weight 1).
+    ``targets``: list of (2 * rows, 3) position deltas. Returns the primitive dict."""
+    y = np.repeat(np.linspace(0.0, height, rows), 2)
+    pos = np.stack([np.tile([-0.05, 0.05], rows), y, np.zeros(2 * rows)], 1) + origin
+    attrs = {"POSITION": b.accessor(pos, "float32", minmax=True),
+             "NORMAL": b.accessor(np.tile([0.0, 0.0, 1.0], (2 * rows, 1)), "float32")}
+    if skinned:
+        top = y / height if len(joints) > 1 else np.zeros_like(y)
+        wt = np.stack([1 - top, top, np.zeros_like(y), np.zeros_like(y)], 1)
+        jt = np.tile([joints[0], joints[-1], 0, 0], (2 * rows, 1))
+        attrs["JOINTS_0"] = b.accessor(jt, "uint8")
+        attrs["WEIGHTS_0"] = b.accessor(wt, "float32")
+    quads = [[2 * i, 2 * i + 1, 2 * i + 3, 2 * i, 2 * i + 3, 2 * i + 2] for i in range(rows - 1)]
+    prim = {"attributes": attrs, "indices": b.accessor(np.ravel(quads), "uint16"), "mode": 4}
+    if targets:
+        prim["targets"] = [{"POSITION": b.accessor(d, "float32", minmax=True)} for d in targets]
+    return prim
+
+
+def two_skins_and_parts(conflict=True):
+    """A figure with two skins that share joints and rigid parts, for the reader's tests.
+
+    Nodes: 0 ``hips`` (root joint) > 1 ``spine`` > 2 ``head`` > 3 ``hat`` (a rigid mesh
+    under a joint, rotated and scaled); 0 > 4 ``leg``; 5 ``body`` (skin 0: hips, spine,
+    head; its mesh also has a rigid-looking second primitive), 6 ``legs`` (skin 1: hips, leg,
+    stored in its own frame: its inverse binds carry an offset ``S``), 7 ``arm`` (skin 2:
+    spine and head, the head's inverse bind offset differently from the spine's when
+    ``conflict``: no single pre-transform serves it), 8 ``base`` (a static mesh at the scene
+    root, bound to the root). One clip bends the spine and swings the leg (the root stays).
+
+    Returns
+    -------
+    builder : GltfBuilder
+    info : dict with "vertices" (the total drawn vertex count) and "S" (4, 4)
+    """
+    b = GltfBuilder()
+    nodes = b.doc["nodes"]
+    nodes += [{"name": "hips", "translation": [0.0, 1.0, 0.0], "children": [1, 4]},
+              {"name": "spine", "translation": [0.0, 0.2, 0.0], "children": [2]},
+              {"name": "head", "translation": [0.0, 0.4, 0.0], "children": [3]},
+              {"name": "hat", "translation": [0.0, 0.25, 0.05], "rotation":
+               [0.0, 0.3826834, 0.0, 0.9238795], "scale": [0.5, 0.5, 0.5], "mesh": 1},
+              {"name": "leg", "translation": [0.1, -0.1, 0.0]},
+              {"name": "body", "mesh": 0, "skin": 0},
+              {"name": "legs", "mesh": 2, "skin": 1},
+              {"name": "arm", "mesh": 3, "skin": 2},
+              {"name": "base", "translation": [0.0, 0.0, 0.3], "mesh": 4}]
+    world = {0: trs_matrix((0, 1, 0))}
+    world[1] = world[0] @ trs_matrix((0, 0.2, 0))
+    world[2] = world[1] @ trs_matrix((0, 0.4, 0))
+    world[4] = world[0] @ trs_matrix((0.1, -0.1, 0))
+    s_off = trs_matrix((0.3, -0.2, 0.1), (0, 0, 0.2588190, 0.9659258), (2, 2, 2))
+
+    def ibm(mats):
+        return b.accessor(np.stack(mats).transpose(0, 2, 1).reshape(-1, 16), "float32")
+
+    body = [_bar_primitive(b, (0, 1.0, 0), [0, 1], height=0.6),
+            _bar_primitive(b, (0.2, 1.4, 0), [2], rows=2, height=0.2)]
+    # skin 1's vertices live in the frame S maps to the bind space: v_bind = S @ v_stored
+    legs = _bar_primitive(b, (0, 0, 0), [0, 1], height=0.8)
+    pos = np.array(b.accessor_data(legs["attributes"]["POSITION"]))
+    stored = (np.c_[pos + [0.1, 0.1, 0.0], np.ones(len(pos))] @ np.linalg.inv(s_off).T)[:, :3]
+    b.replace_accessor(legs["attributes"]["POSITION"], stored)
+    arm_off = trs_matrix((0.0, 0.05, 0.0)) if conflict else np.eye(4)
+    b.doc["meshes"] += [{"name": "body", "primitives": body},
+                        {"name": "hat", "primitives": [_bar_primitive(b, (0, 0, 0), [0],
+                                                                      rows=2, skinned=False)]},
+                        {"name": "legs", "primitives": [legs]},
+                        {"name": "arm", "primitives": [_bar_primitive(b, (0.3, 1.3, 0), [0, 1])]},
+                        {"name": "base", "primitives": [_bar_primitive(b, (0, 0, 0), [0], rows=2,
+                                                                       skinned=False)]}]
+    inv = {k: np.linalg.inv(m) for k, m in world.items()}
+    b.doc["skins"] += [{"joints": [0, 1, 2], "inverseBindMatrices": ibm([inv[0], inv[1], inv[2]])},
+                       {"joints": [0, 4], "inverseBindMatrices": ibm([inv[0] @ s_off,
+                                                                      inv[4] @ s_off])},
+                       {"joints": [1, 2], "inverseBindMatrices": ibm([inv[1], inv[2] @ arm_off])}]
+    b.doc["scenes"][0]["nodes"] = [0, 5, 6, 7, 8]
+    times = np.array([0.0, 0.5, 1.0])
+    ang = np.radians([0, 25, 50]) / 2
+    bend = np.stack([np.sin(ang), np.zeros(3), np.zeros(3), np.cos(ang)], 1)
+    swing = np.stack([np.zeros(3), np.zeros(3), np.sin(ang), np.cos(ang)], 1)
+    t_acc = b.accessor(times, "float32", minmax=True)
+    b.doc["animations"] = [{"name": "move", "samplers": [
+        {"input": t_acc, "output": b.accessor(bend, "float32")},
+        {"input": t_acc, "output": b.accessor(swing, "float32")}],
+        "channels": [{"sampler": 0, "target": {"node": 1, "path": "rotation"}},
+                     {"sampler": 1, "target": {"node": 4, "path": "rotation"}}]}]
+    count = 8 + 4 + 4 + 8 + 8 + 4
+    return b, {"vertices": count, "S": s_off}

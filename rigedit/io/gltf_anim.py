@@ -2,8 +2,11 @@
 
 Samplers map to rigedit's interpolation modes exactly: ``STEP`` -> ``step``, ``LINEAR`` ->
 ``linear`` (translation, scale) or ``slerp`` (rotation, as the spec asks), ``CUBICSPLINE`` ->
-``cubic_spline`` with the file's in- and out-tangents kept (not resampled). Channels on nodes
-that are not joints and morph-weight channels are skipped, each kind with one warning. Keys of a
+``cubic_spline`` with the file's in- and out-tangents kept (not resampled). A ``weights``
+channel on a mesh node with morph targets becomes one weight track per target
+(:class:`~rigedit.animation.morph_track.WeightTrack`, the same three modes, tangents kept).
+Channels on nodes that are not joints, and weight channels on nodes without targets, are
+skipped, each kind with one warning. Keys of a
 joint below folded non-joint ancestors are mapped through that similarity like its rest
 transform (affine on values, linear on tangents, so the curve maps exactly).
 """
@@ -16,10 +19,11 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..animation.clip import Clip, Track
+from ..animation.morph_track import WeightTrack
 from ..animation.clip_names import MAX_NAME_LENGTH, check_clip_name, name_key
 from ..errors import RigFileError
 
-__all__ = ["read_clips", "clip_names", "quat_left_matrix"]
+__all__ = ["read_clips", "weight_tracks", "clip_names", "quat_left_matrix"]
 
 _MODES = {"STEP": {"translation": "step", "rotation": "step", "scale": "step"},
           "LINEAR": {"translation": "linear", "rotation": "slerp", "scale": "linear"},
@@ -76,15 +80,15 @@ def _fold(prefix, channel, values, tangents):
     return values, tangents
 
 
-def _channel_track(data, anim_index, anim, channel, ci, prefix):
-    where = f"animation {anim_index} channel {ci}"
+def _sampler(data, anim, channel, where):
+    """(interpolation, (K,) key times, output values as float64) of a channel's sampler,
+    checked."""
     samplers = anim.samplers or []
     s = channel.sampler
     if not isinstance(s, int) or not 0 <= s < len(samplers):
         raise RigFileError(data.path, f"{where}: expected a sampler index below {len(samplers)}, "
                                       f"got {s!r}")
     sampler = samplers[s]
-    path = channel.target.path
     interp = sampler.interpolation or "LINEAR"
     if not isinstance(interp, str) or interp not in _MODES:
         raise RigFileError(data.path, f"{where}: expected interpolation LINEAR, STEP or "
@@ -97,6 +101,38 @@ def _channel_track(data, anim_index, anim, channel, ci, prefix):
         raise RigFileError(data.path, f"{where}: expected finite, strictly increasing key "
                                       "times, got NaN or a repeated/decreasing time")
     values = np.asarray(data.accessor(sampler.output, f"{where} output"), dtype=np.float64)
+    return interp, times, values
+
+
+def weight_tracks(data, anim_index, anim, channel, ci, names):
+    """``{target name: WeightTrack}`` of a ``weights`` channel on a node whose targets are
+    ``names``: the output holds, per key, one weight per target (CUBICSPLINE: in-tangents,
+    values, out-tangents, each a block of one per target)."""
+    where = f"animation {anim_index} channel {ci}"
+    interp, times, values = _sampler(data, anim, channel, where)
+    per_key = 3 if interp == "CUBICSPLINE" else 1
+    m = len(names)
+    if values.shape != (len(times) * per_key * m, 1):
+        raise RigFileError(data.path, f"{where}: expected {len(times) * per_key * m} SCALAR "
+                                      f"weights ({m} targets), got {values.shape}")
+    if not np.all(np.isfinite(values)):
+        raise RigFileError(data.path, f"{where}: expected finite weights, got NaN or inf")
+    v = values.reshape(len(times), per_key, m)
+    mid = 1 if per_key == 3 else 0
+    out = {}
+    try:
+        for i, name in enumerate(names):
+            tangents = (v[:, 0, i], v[:, 2, i]) if per_key == 3 else (None, None)
+            out[name] = WeightTrack(times, v[:, mid, i], interp, *tangents)
+    except ValueError as exc:
+        raise RigFileError(data.path, f"{where}: {exc}") from None
+    return out
+
+
+def _channel_track(data, anim_index, anim, channel, ci, prefix):
+    where = f"animation {anim_index} channel {ci}"
+    path = channel.target.path
+    interp, times, values = _sampler(data, anim, channel, where)
     width = _WIDTH[path]
     per_key = 3 if interp == "CUBICSPLINE" else 1
     if values.shape != (len(times) * per_key, width):
@@ -116,8 +152,14 @@ def _channel_track(data, anim_index, anim, channel, ci, prefix):
         raise RigFileError(data.path, f"{where}: {exc}") from None
 
 
-def read_clips(data, skeleton, smap, warning):
+def read_clips(data, skeleton, smap, warning, morph_nodes=None):
     """Every animation of the file as a :class:`Clip` on ``skeleton``.
+
+    Parameters
+    ----------
+    morph_nodes : dict[int, list[str]], optional
+        Mesh node -> the names of its morph targets: its ``weights`` channels become one
+        weight track per target.
 
     Returns
     -------
@@ -125,9 +167,10 @@ def read_clips(data, skeleton, smap, warning):
     """
     anims = data.gltf.animations or []
     names = clip_names([a.name for a in anims])
+    morph_nodes = morph_nodes or {}
     clips, off_skeleton, morph = {}, set(), 0
     for a, (name, anim) in enumerate(zip(names, anims)):
-        tracks = {}
+        tracks, weights = {}, {}
         for ci, channel in enumerate(anim.channels or []):
             target = channel.target
             if target is None or target.node is None:
@@ -139,7 +182,11 @@ def read_clips(data, skeleton, smap, warning):
                                               f"node below {nodes} and a path, got "
                                               f"{target.node!r} and {target.path!r}")
             if target.path == "weights":
-                morph += 1
+                if target.node in morph_nodes:
+                    weights.update(weight_tracks(data, a, anim, channel, ci,
+                                                 morph_nodes[target.node]))
+                else:
+                    morph += 1
                 continue
             if target.path not in _WIDTH:
                 raise RigFileError(data.path, f"animation {a} channel {ci}: expected a target "
@@ -155,16 +202,17 @@ def read_clips(data, skeleton, smap, warning):
         own = anim.extras.get("rigedit") if isinstance(anim.extras, dict) else None
         own = own if isinstance(own, dict) else {}
         duration = own.get("duration")
-        last = max((tr.times[-1] for tr in tracks.values()), default=0.0)
+        last = max((tr.times[-1] for tr in (*tracks.values(), *weights.values())),
+                   default=0.0)
         if not isinstance(duration, (int, float)) or not last <= duration < 1e9:
             duration = None
         clips[name] = Clip(name, skeleton, tracks, duration=duration,
-                           loop=bool(own.get("loop", True)))
+                           loop=bool(own.get("loop", True)), morph_tracks=weights)
     if off_skeleton:
         warnings.warn(f"{data.path}: skipped animation channels on {len(off_skeleton)} nodes "
                       f"that are not joints of the skin (nodes {sorted(off_skeleton)[:8]})",
                       warning, stacklevel=3)
     if morph:
-        warnings.warn(f"{data.path}: skipped {morph} morph-target weight channels (rigedit has "
-                      "no morph targets)", warning, stacklevel=3)
+        warnings.warn(f"{data.path}: skipped {morph} morph-target weight channels on nodes "
+                      "without morph targets", warning, stacklevel=3)
     return clips

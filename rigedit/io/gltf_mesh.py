@@ -1,16 +1,20 @@
-"""glTF 2.0 in: the primitives bound to a skin, merged into one mesh, and their materials."""
+"""glTF 2.0 in: the primitives of the drawn mesh nodes (skinned or rigid), merged into one
+mesh, with their materials and morph targets."""
 from __future__ import annotations
 
 import io
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Optional
 
 import numpy as np
 
 from ..errors import RigFileError
+from ..model.morph import MorphTargets
 from ..surface import Material, Surface
+from .gltf_morph import assemble_morphs, mesh_morph_block, read_targets
 
-__all__ = ["read_mesh", "MeshData", "triangles", "decode_image"]
+__all__ = ["read_mesh", "MeshData", "MeshPart", "triangles", "decode_image"]
 
 #: glTF primitive modes that make triangles.
 TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN = 4, 5, 6
@@ -18,14 +22,17 @@ TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN = 4, 5, 6
 
 @dataclass
 class MeshData:
-    """Merged mesh: ``vertices`` (V, 3), ``faces`` (F, 3) int64, ``joints`` (V, K) skin joint
-    indices, ``weights`` (V, K) rows summing to 1, ``surface``."""
+    """Merged mesh: ``vertices`` (V, 3), ``faces`` (F, 3) int64, ``joints`` (V, K) skeleton
+    joint indices, ``weights`` (V, K) rows summing to 1, ``surface``, ``morphs`` (or None)
+    and ``morph_nodes`` (mesh node -> its target names)."""
 
     vertices: np.ndarray
     faces: np.ndarray
     joints: np.ndarray
     weights: np.ndarray
     surface: Surface
+    morphs: Optional[MorphTargets] = None
+    morph_nodes: dict = field(default_factory=dict)
 
 
 def triangles(indices, mode):
@@ -140,32 +147,92 @@ def _influences(data, attrs, n, num_joints, where):
     return j, w
 
 
-def read_mesh(data, mesh_nodes, num_joints, warning):
-    """Merge every triangle primitive of the meshes of ``mesh_nodes``.
+@dataclass
+class MeshPart:
+    """One mesh node to merge.
+
+    Attributes
+    ----------
+    node : int
+    joint_map : (K,) int64
+        Skin joint slot -> skeleton joint (a rigid part: its one joint).
+    transform : (4, 4) array or None
+        Applied to the vertices (normals, morph deltas) first: a rigid part's placement in
+        bind space, a skin's shared-bind offset; None for none.
+    skinned : bool
+        False for a rigid part: every vertex bound wholly to ``joint_map[0]``.
+    """
+
+    node: int
+    joint_map: np.ndarray
+    transform: Optional[np.ndarray] = None
+    skinned: bool = True
+
+
+def _indices(data, prim, n, where):
+    if prim.indices is None:
+        return np.arange(n)
+    idx = data.accessor(prim.indices, f"{where} indices")
+    if idx.shape[1] != 1 or idx.dtype.kind != "u":
+        raise RigFileError(data.path, f"{where}: expected unsigned SCALAR indices, "
+                                      f"got {idx.dtype} of width {idx.shape[1]}")
+    idx = idx[:, 0].astype(np.int64)
+    if idx.size and idx.max() >= n:
+        raise RigFileError(data.path, f"{where}: expected indices below {n} "
+                                      f"vertices, got {idx.max()}")
+    return idx
+
+
+def _positions(data, prim, where):
+    pos = _attr(data, prim.attributes, "POSITION", where)
+    if pos is None or pos.shape[1] != 3:
+        raise RigFileError(data.path, f"{where}: expected a VEC3 POSITION, got "
+                                      f"{None if pos is None else pos.shape}")
+    pos = pos.astype(np.float64)
+    if not np.all(np.isfinite(pos)):
+        raise RigFileError(data.path, f"{where}: expected finite POSITION values, got "
+                                      "NaN or inf")
+    return pos
+
+
+def _place(m, pos, nrm, tri, deltas, ndeltas):
+    """Apply the (4, 4) affine ``m``: points, normals (inverse transpose), deltas (linear
+    part); a mirroring ``m`` reverses the winding so faces keep facing out."""
+    lin = m[:3, :3]
+    inv = np.linalg.inv(lin)
+    pos = pos @ lin.T + m[:3, 3]
+    nrm = None if nrm is None else nrm @ inv
+    deltas = deltas @ lin.T
+    ndeltas = None if ndeltas is None else ndeltas @ inv
+    if np.linalg.det(lin) < 0:
+        tri = tri[:, [0, 2, 1]]
+    return pos, nrm, tri, deltas, ndeltas
+
+
+def read_mesh(data, parts, warning):
+    """Merge every triangle primitive of the mesh nodes ``parts``, in their order.
 
     Parameters
     ----------
     data : GltfData
-    mesh_nodes : list[int]
-        Nodes that hold a mesh bound to the chosen skin.
-    num_joints : int
-        Joints of the skin (JOINTS_n values must be below it).
+    parts : list[MeshPart]
     warning : type
         Warning class for skipped parts.
 
     Returns
     -------
     MeshData
+        ``joints`` are skeleton joints; ``morphs`` the merged morph targets.
     """
     meshes = data.gltf.meshes or []
-    verts, faces, joints, weights, normals, uvs, prim_of, prim_mat = [], [], [], [], [], [], [], []
-    skipped, morphed = set(), 0
-    offset = 0
-    for node in mesh_nodes:
-        m = data.gltf.nodes[node].mesh
+    acc = {k: [] for k in ("verts", "faces", "joints", "weights", "normals", "uvs", "prim_of")}
+    prim_mat, blocks, skipped, offset, unweighted = [], [], set(), 0, 0
+    for part in parts:
+        m = data.gltf.nodes[part.node].mesh
         if not 0 <= m < len(meshes):
-            raise RigFileError(data.path, f"node {node}: expected a mesh index below "
+            raise RigFileError(data.path, f"node {part.node}: expected a mesh index below "
                                           f"{len(meshes)}, got {m}")
+        block = None
         for p, prim in enumerate(meshes[m].primitives or []):
             where = f"mesh {m} primitive {p}"
             mode = TRIANGLES if prim.mode is None else prim.mode
@@ -174,47 +241,59 @@ def read_mesh(data, mesh_nodes, num_joints, warning):
             if mode not in (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN):
                 skipped.add(mode)
                 continue
-            pos = _attr(data, prim.attributes, "POSITION", where)
-            if pos is None or pos.shape[1] != 3:
-                raise RigFileError(data.path, f"{where}: expected a VEC3 POSITION, got "
-                                              f"{None if pos is None else pos.shape}")
-            pos = pos.astype(np.float64)
-            if not np.all(np.isfinite(pos)):
-                raise RigFileError(data.path, f"{where}: expected finite POSITION values, got "
-                                              "NaN or inf")
+            pos = _positions(data, prim, where)
             n = len(pos)
-            if prim.indices is None:
-                idx = np.arange(n)
+            tri = triangles(_indices(data, prim, n, where), mode)
+            if part.skinned:
+                j, w = _influences(data, prim.attributes, n, len(part.joint_map), where)
+                empty = w.sum(axis=1) <= 0   # bound to the skin's first joint (warned below)
+                w[empty, 0], j[empty, 0] = 1.0, 0
+                unweighted += int(empty.sum())
             else:
-                idx = data.accessor(prim.indices, f"{where} indices")
-                if idx.shape[1] != 1 or idx.dtype.kind != "u":
-                    raise RigFileError(data.path, f"{where}: expected unsigned SCALAR indices, "
-                                                  f"got {idx.dtype} of width {idx.shape[1]}")
-                idx = idx[:, 0].astype(np.int64)
-                if idx.size and idx.max() >= n:
-                    raise RigFileError(data.path, f"{where}: expected indices below {n} "
-                                                  f"vertices, got {idx.max()}")
-            j, w = _influences(data, prim.attributes, n, num_joints, where)
-            morphed += bool(prim.targets)
+                j, w = np.zeros((n, 1), np.int64), np.ones((n, 1))
             nrm = _attr(data, prim.attributes, "NORMAL", where)
+            nrm = None if nrm is None else nrm[:, :3].astype(np.float64)
             uv = _attr(data, prim.attributes, "TEXCOORD_0", where)
-            verts.append(pos)
-            faces.append(triangles(idx, mode) + offset)
-            joints.append(j)
-            weights.append(w)
-            normals.append(None if nrm is None else nrm[:, :3].astype(np.float64))
-            uvs.append(None if uv is None else uv[:, :2].astype(np.float64))
-            prim_of.append(np.full(n, len(prim_mat), dtype=np.int32))
-            prim_mat.append(-1 if prim.material is None else int(prim.material))
+            deltas, ndeltas = read_targets(data, prim, n, where)
+            if block is None:
+                block = mesh_morph_block(data, part.node, len(deltas))
+            elif len(deltas) != len(block.names):
+                raise RigFileError(data.path, f"{where}: expected {len(block.names)} morph "
+                                              f"targets as the mesh's first primitive, got "
+                                              f"{len(deltas)}")
+            if part.transform is not None:
+                pos, nrm, tri, deltas, ndeltas = _place(part.transform, pos, nrm, tri, deltas,
+                                                        ndeltas)
+            block.rows.append((offset, deltas, ndeltas))
+            for key, value in (("verts", pos), ("faces", tri + offset),
+                               ("joints", part.joint_map[j]), ("weights", w), ("normals", nrm),
+                               ("uvs", None if uv is None else uv[:, :2].astype(np.float64)),
+                               ("prim_of", np.full(n, len(prim_mat), dtype=np.int32))):
+                acc[key].append(value)
+            prim_mat.append(-1 if prim.material is None else _material_index(data, prim, where))
             offset += n
+        if block is not None:
+            blocks.append(block)
     if skipped:
         warnings.warn(f"{data.path}: skipped primitives that are not triangles (modes "
                       f"{sorted(skipped)})", warning, stacklevel=3)
-    if morphed:
-        warnings.warn(f"{data.path}: ignored the morph targets of {morphed} primitives "
-                      "(rigedit has none; the base shape is used)", warning, stacklevel=3)
-    return _merge(data, verts, faces, joints, weights, normals, uvs, prim_of, prim_mat,
-                  warning)
+    if unweighted:
+        warnings.warn(f"{data.path}: {unweighted} vertices have no skin weight; bound to "
+                      "the skin's first joint", warning, stacklevel=3)
+    mesh = _merge(data, acc["verts"], acc["faces"], acc["joints"], acc["weights"],
+                  acc["normals"], acc["uvs"], acc["prim_of"], prim_mat, warning)
+    try:
+        mesh.morphs, mesh.morph_nodes = assemble_morphs(blocks, offset)
+    except ValueError as exc:   # MorphTargets' own checks
+        raise RigFileError(data.path, f"morph targets: {exc}") from None
+    return mesh
+
+
+def _material_index(data, prim, where):
+    if not isinstance(prim.material, int) or prim.material < 0:
+        raise RigFileError(data.path, f"{where}: expected a material index >= 0, got "
+                                      f"{prim.material!r}")
+    return int(prim.material)
 
 
 def _pad(arrays, k):
@@ -228,12 +307,7 @@ def _merge(data, verts, faces, joints, weights, normals, uvs, prim_of, prim_mat,
                                                   np.zeros(0, np.int64), _materials(data, warning)))
     k = max(a.shape[1] for a in joints)
     j, w = _pad(joints, k), _pad(weights, k)
-    total = w.sum(axis=1)
-    empty = total <= 0
-    if empty.any():
-        warnings.warn(f"{data.path}: {int(empty.sum())} vertices have no skin weight; bound to "
-                      "the skin's first joint", warning, stacklevel=4)
-        w[empty, 0], j[empty, 0], total[empty] = 1.0, 0, 1.0
+    total = w.sum(axis=1)   # > 0: read_mesh bound unweighted rows
     w = w / total[:, None]
     nrm = None
     if all(n is not None for n in normals):
