@@ -126,8 +126,10 @@ def _skeleton(path, nodes, mesh, moved):
             tt, rr, ss = decompose_trs((prefix[n] @ nodes.local[n])[None])
             t.append(tt[0]), r.append(rr[0]), s.append(ss[0])
     parents = [-1 if parent_of[n] is None else joint_of[parent_of[n]] for n in ordered]
+    # joints with a cluster deform; in a file without a skin (a skeleton and its motion, as
+    # BVH gives) every joint does, so the rig can be retargeted from
     binds = set(mesh.inverse_bind) | set(mesh.mesh_node[mesh.unweighted].tolist())
-    deform = np.array([n in binds for n in ordered])
+    deform = np.array([n in binds or not binds for n in ordered])
     rest = Skeleton([name_of[n] for n in ordered], parents, np.array(t), np.array(r),
                     np.array(s), deform=deform)
     inverse = np.linalg.inv(rest.bind_matrices)
@@ -215,7 +217,20 @@ def load_fbx(path):
     return build_rig(read_fbx(path))
 
 
+def _ufbx_warnings(scene, path):
+    """One warning for what ufbx repaired while reading (indices out of range clamped, ...)."""
+    counts = {}
+    for w in scene.metadata.warnings:
+        counts[w.description] = counts.get(w.description, 0) + max(1, int(w.count))
+    if counts:
+        kinds = "1 kind of problem" if len(counts) == 1 else f"{len(counts)} kinds of problem"
+        warnings.warn(f"{path}: ufbx repaired {kinds} while reading: " + "; ".join(
+            f"{d} ({n} times)" if n > 1 else d for d, n in list(counts.items())[:4]),
+            FbxWarning, stacklevel=4)
+
+
 def _read(scene, keep, path):
+    _ufbx_warnings(scene, path)
     settings = scene.settings
     fps = float(settings.frames_per_second)
     fps = fps if np.isfinite(fps) and 1.0 <= fps <= 1000.0 else 30.0
@@ -227,7 +242,8 @@ def _read(scene, keep, path):
     stacks = bake_stacks(scene, keep, fps)
     moved = animated_nodes(stacks, {i: nodes.rest(i) for i in range(len(nodes.names))})
     skeleton, joint_of, prefix = _skeleton(path, nodes, mesh, moved)
-    indices, weights = _influences(mesh, joint_of, path) if len(mesh.vertices) else (None, None)
+    indices, weights = (_influences(mesh, joint_of, path) if len(mesh.vertices) else
+                        (np.zeros((0, 1), np.int64), np.zeros((0, 1))))   # no mesh, as BVH
     clips, shifts = clips_of(stacks, skeleton, joint_of, prefix, mesh.channels)
     notes, unit = _notes(settings)
     notes["frames"] += f"; clips baked at {fps:g} frames per second"

@@ -87,6 +87,8 @@ def _rig(fbx):
     if fbx not in _RIGS:
         with warnings.catch_warnings():
             warnings.simplefilter("error")          # these files read without a warning
+            # but for MotionBuilder's strings that are not UTF-8, which ufbx repairs
+            warnings.filterwarnings("ignore", message=".*ufbx repaired 1 kind of problem")
             data = read_fbx(UFBX / fbx)
         _RIGS[fbx] = (data, Rig.from_data(data))
     return _RIGS[fbx]
@@ -141,6 +143,21 @@ def test_mixamo_skeleton_weights_and_clips():
     a, b = rig.skin(clip.sample(1.0)), rig.skin(clip.sample(2.0))
     assert np.abs(a - b).max() > 0.05                 # the clip moves the character
     assert np.all(np.isfinite(a))
+
+
+def test_skeleton_and_motion_without_a_mesh():
+    path = UFBX / "maya_human_ik_7400_binary.fbx"
+    _need(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")        # no "computed weights" for a mesh-less rig
+        rig = Rig.from_data(read_fbx(path))
+    assert len(rig.vertices) == 0 and len(rig.skeleton) == 62 and rig.skeleton.deform.all()
+    clip = rig.clips["Take 001"]
+    assert abs(clip.duration - 5.0) < 1e-6 and len(clip.tracks) > 60
+    # its take keys the HumanIK control rig, which only Maya solves: the limb nodes keep
+    # their pose; in metres, the head's joints 1.5-1.8 m above the floor
+    heads = rig.joint_matrices(clip.sample(2.5))[:, :3, 3]
+    assert 1.5 < heads[:, 1].max() < 1.8 and abs(heads[:, 1].min()) < 0.1
 
 
 def test_reading_twice_in_one_process():
