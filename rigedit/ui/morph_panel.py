@@ -4,7 +4,8 @@ The panel never edits data itself: a slider held is an :class:`~rigedit.editor.m
 WeightDrag` (the mesh follows, one undo step at the release), a click on the slider's groove
 or a typed number is :func:`~rigedit.editor.morphs.set_weight`, and the key button is
 :func:`~rigedit.editor.morphs.key_weight` at the document's time on its current clip (the
-timeline's key row then shows the key). It follows the document's events: the weights shown
+timeline's key row then shows the key; its right-click menu deletes the key at the current
+time). It follows the document's events: the weights shown
 (MorphChanged: the clip sampled, an undo), the keys at the current time (KeysChanged,
 TimeChanged, ClipChanged), a new rig (RigReplaced: the rows are built again).
 """
@@ -41,8 +42,13 @@ class _Row:
         self.spin.setKeyboardTracking(False)   # one edit per number typed, not per digit
         self.key = QtWidgets.QToolButton()
         self.key.setText(KEY_OFF)
-        self.key.setToolTip(f"Key {name} at the current time on the current clip")
+        self.key.setToolTip(f"Key {name} at the current time on the current clip "
+                            f"(right-click: delete the key there)")
         self.key.setAutoRaise(True)
+        self.key.setContextMenuPolicy(QtCore.Qt.ActionsContextMenu)
+        self.delete_action = QtWidgets.QAction(f"Delete {name} key", self.key)
+        self.delete_action.triggered.connect(lambda: panel.delete_key(name))
+        self.key.addAction(self.delete_action)
         for col, widget in enumerate((self.label, self.slider, self.spin, self.key)):
             grid.addWidget(widget, row, col)
         self.slider.sliderPressed.connect(lambda: panel.drag_started(name))
@@ -60,6 +66,7 @@ class _Row:
         for widget in (self.slider, self.spin):
             widget.blockSignals(False)
         self.key.setText(KEY_ON if keyed else KEY_OFF)
+        self.delete_action.setEnabled(keyed)
 
 
 class MorphPanel(QtWidgets.QWidget):
@@ -153,6 +160,10 @@ class MorphPanel(QtWidgets.QWidget):
     def key(self, name):
         """Key ``name``'s weight shown at the current time (one undo step)."""
         self._guard(morphs.key_weight, self.document, name)
+
+    def delete_key(self, name):
+        """Delete ``name``'s key at the current time (one undo step), if it has one."""
+        self._guard(morphs.delete_weight_key, self.document, name)
 
     def _guard(self, edit, *args):
         try:

@@ -211,3 +211,26 @@ def test_a_sequence_of_weights_on_overlapping_targets_always_gives_rest_plus_the
             np.testing.assert_allclose(mr.normals, normals + np.tensordot(w, ndeltas, 1),
                                        atol=1e-5)
     np.testing.assert_array_equal(rest, mr.rest)          # the rest itself never written
+
+
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+@pytest.mark.parametrize("method", ["lbs", "dqs"])
+def test_every_path_skins_the_morphed_rest_as_a_binding_of_it_would(backend, method):
+    rig = _morph_rig(seed=2)
+    if backend == "numba" and skinning_kernels.load() is None:
+        pytest.skip("the compiled kernels do not load here")
+    b = rig.binding
+    rest_n = vertex_normals(rig.vertices, rig.faces)
+    b.bind_normals(rest_n)
+    b.set_morph_weights([0.6, -0.9])
+    morphed = rig.vertices + 0.6 * rig.morphs.deltas[0] - 0.9 * rig.morphs.deltas[1]
+    moved_n = rest_n - 0.9 * rig.morphs.normal_deltas[1]
+    want = SkinBinding(morphed, b.indices, b.weights, 3)
+    want.bind_normals(moved_n)
+    palette = skinning_matrices(rig.skeleton, local_to_model(rig.skeleton, _pose(rig, 7)))
+    np.testing.assert_allclose(b.skin(palette, method=method, backend=backend),
+                               want.skin(palette, method=method, backend=backend), atol=2e-5)
+    got_p, got_n = b.skin_with_normals(palette, backend=backend, method=method)
+    want_p, want_n = want.skin_with_normals(palette, backend=backend, method=method)
+    np.testing.assert_allclose(got_p, want_p, atol=2e-5)
+    np.testing.assert_allclose(got_n, want_n, atol=1e-4)

@@ -69,10 +69,16 @@ def test_the_key_button_keys_the_current_clip_and_the_timeline_shows_it(qtbot, m
     assert row.key.text() == "◆"
     assert d.undo_stack.undo_label == "Key squash at 0.50s"
     assert np.any(np.isclose(w.timeline.ruler.summary_keys, 0.5))      # the key row's mark
+    assert row.delete_action.isEnabled()
     d.set_time(0.0)
-    assert row.key.text() == "◇"
+    assert row.key.text() == "◇" and not row.delete_action.isEnabled()
     w.undo_action.trigger()
     assert "squash" not in clip.morph_tracks
+    w.redo_action.trigger()
+    d.set_time(0.5)
+    row.delete_action.trigger()                       # the key button's right-click menu
+    assert "squash" not in clip.morph_tracks and row.key.text() == "◇"
+    assert d.undo_stack.undo_label == "Delete squash key at 0.50s"
 
 
 def test_a_rig_without_shapes_hides_the_dock(qtbot):
