@@ -157,7 +157,12 @@ def cmd_export(args):
     import rigedit
 
     rig = _load(args.rig, scale=args.scale)
-    rigedit.save_rig(rig, args.output, clips=args.clip)
+    if Path(args.output).suffix.lower() == ".fbx":
+        from ..io.fbx_write import write_fbx
+
+        write_fbx(rig.data(), args.output, clips=args.clip, units=args.fbx_units)
+    else:
+        rigedit.save_rig(rig, args.output, clips=args.clip)
     clips = args.clip or sorted(rig.clips)
     if Path(args.output).suffix.lower() == ".bvh":
         clips = clips[:1]
@@ -222,11 +227,16 @@ def build_parser():
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     _scale_option(s)
     s.set_defaults(func=cmd_render)
-    s = sub.add_parser("export", help="write a rig as glTF (.glb/.gltf), BVH or a rig folder")
+    s = sub.add_parser("export",
+                       help="write a rig as glTF (.glb/.gltf), FBX, BVH or a rig folder")
     s.add_argument("rig")
-    s.add_argument("-o", "--output", required=True, metavar="OUT.glb|OUT.gltf|OUT.bvh|FOLDER")
+    s.add_argument("-o", "--output", required=True,
+                   metavar="OUT.glb|OUT.gltf|OUT.fbx|OUT.bvh|FOLDER")
     s.add_argument("--clip", action="append", default=None, metavar="NAME",
                    help="a clip to write (repeat for several; default all, BVH: the first)")
+    s.add_argument("--fbx-units", choices=("cm", "m"), default="cm",
+                   help="length unit of an .fbx OUT: cm (the default, what Unity and Unreal "
+                        "import at scale 1) or m")
     _scale_option(s)
     s.set_defaults(func=cmd_export)
     s = sub.add_parser("retarget", help="retarget a motion (BVH, glTF, rig folder) onto a rig")

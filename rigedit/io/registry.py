@@ -9,7 +9,8 @@ of clip names. A new format is one reader, one writer and one line of :data:`FOR
 ``gltf``    ``.glb``, ``.gltf``   :mod:`rigedit.io.gltf_read`, :mod:`rigedit.io.gltf_write`
 ``bvh``     ``.bvh``              :mod:`rigedit.io.bvh`, :mod:`rigedit.io.bvh_write`: a
                                   skeleton and one clip, no mesh
-``fbx``     ``.fbx``              :mod:`rigedit.io.fbx_read` (through ufbx)
+``fbx``     ``.fbx``              :mod:`rigedit.io.fbx_read` (through ufbx),
+                                  :mod:`rigedit.io.fbx_write` (binary FBX 7.4)
 ==========  ====================  =================================================
 """
 from __future__ import annotations
@@ -22,6 +23,7 @@ from ..errors import RigFileError
 from .bvh import read_bvh
 from .bvh_write import write_bvh
 from .fbx_read import read_fbx
+from .fbx_write import write_fbx
 from .gltf_read import read_gltf
 from .gltf_write import save_gltf
 from .paths import what_is
@@ -46,14 +48,8 @@ FORMATS = (
     Format("folder", (), read_rig_folder, write_rig_folder),
     Format("gltf", (".glb", ".gltf"), read_gltf, save_gltf),
     Format("bvh", (".bvh",), read_bvh, write_bvh, options=("scale",)),
-    Format("fbx", (".fbx",), read_fbx, lambda data, path, clips=None: _no_fbx_writer(path)),
+    Format("fbx", (".fbx",), read_fbx, write_fbx),
 )
-
-
-def _no_fbx_writer(path):
-    # until rigedit/io/fbx_write.py (issue 19, section 2) takes this place
-    raise RigFileError(path, "expected a .glb, .gltf, .bvh file or a folder to write; FBX "
-                             "writing is not available yet")
 
 #: File suffixes that hold a whole rig (besides folders and bundled names).
 RIG_FILE_SUFFIXES = tuple(s for f in FORMATS for s in f.suffixes)

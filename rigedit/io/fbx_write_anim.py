@@ -1,0 +1,134 @@
+"""FBX out: every clip as an animation stack.
+
+A clip becomes an ``AnimationStack`` (its time span 0 to the clip's duration) with one
+``AnimationLayer``; each track of a joint becomes an ``AnimationCurveNode`` (``T``, ``R`` or
+``S``) on the joint's ``Lcl Translation``, ``Lcl Rotation`` or ``Lcl Scaling`` with three
+``AnimationCurve`` children (``d|X``, ``d|Y``, ``d|Z``): key times in FBX ticks
+(:data:`~rigedit.io.fbx_document.TICKS_PER_SECOND`), float values, and one interpolation flag
+for all keys (linear, or constant for a ``step`` track). Joints without a track keep their
+rest transform (the models' static ``Lcl`` values).
+
+FBX curves are per Euler angle and interpolate each one linearly, which is not a slerp of
+quaternions (nor a spline), so a track is sampled rather than copied: at its own keys and at
+every frame of the scene's rate (:data:`FPS`), so that rigedit and the file agree exactly at
+every frame and closely between. A translation or scale track of ``linear`` or ``step`` keys
+is the same curve in FBX and is written at its keys only. Rotations are Euler XYZ degrees
+(matrix Rz·Ry·Rx, FBX's ``eEulerXYZ``) made continuous from key to key (each key the
+equivalent triple nearest the one before), since FBX interpolates the numbers as written.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.transforms import quat_to_euler
+from .fbx_document import TICKS_PER_SECOND, properties70, ticks
+
+__all__ = ["write_clips", "continuous_euler", "sample_times", "FPS"]
+
+#: The scene's frame rate: every track is keyed at least at each of its frames.
+FPS = 30.0
+_CURVE_NODE = {"translation": ("T", "Lcl Translation"), "rotation": ("R", "Lcl Rotation"),
+               "scale": ("S", "Lcl Scaling")}
+# KeyAttrFlags (FbxAnimCurveDef): eInterpolationConstant 0x2, eInterpolationLinear 0x4
+_LINEAR, _CONSTANT = 0x4, 0x2
+
+
+def _wrap(degrees):
+    """Angles into [-180, 180)."""
+    return (degrees + 180.0) % 360.0 - 180.0
+
+
+def continuous_euler(quats):
+    """(T, 4) quaternions -> (T, 3) Euler XYZ degrees, each row the equivalent triple nearest
+    the row before (so linear interpolation between rows takes the short way).
+
+    Each rotation has two XYZ triples up to whole turns, ``(a, b, c)`` and ``(a + 180,
+    180 - b, c + 180)``; the choice of the twin at row ``i`` is relative to row ``i - 1``'s,
+    and the distance from a triple to the twin of another equals the distance from its twin to
+    that one, so the parities are a cumulative xor of neighbour comparisons, and the whole
+    turns a cumulative sum of wrapped differences: no Python loop over the keys.
+    """
+    e = quat_to_euler(np.asarray(quats, dtype=np.float64), degrees=True).reshape(-1, 3)
+    if len(e) < 2:
+        return e
+    twin = np.column_stack([e[:, 0] + 180.0, 180.0 - e[:, 1], e[:, 2] + 180.0])
+    same = np.abs(_wrap(e[1:] - e[:-1])).sum(axis=1)
+    cross = np.abs(_wrap(twin[1:] - e[:-1])).sum(axis=1)
+    parity = np.concatenate([[False], np.logical_xor.accumulate(cross < same)])
+    chosen = np.where(parity[:, None], twin, e)
+    chosen[0] = e[0]
+    steps = _wrap(np.diff(chosen, axis=0))
+    return np.vstack([chosen[:1], chosen[0] + np.cumsum(steps, axis=0)])
+
+
+def sample_times(track, duration, fps=FPS):
+    """(N,) times a track is written at, seconds: its keys within ``[0, duration]``, both
+    ends, and every frame when FBX's linear curve is not the track's own (rotations, splines);
+    no two in the same tick."""
+    times = [track.times[(track.times >= 0) & (track.times <= duration)], [0.0, duration]]
+    exact = track.channel != "rotation" and track.interpolation in ("linear", "step")
+    if not exact:
+        times.append(np.arange(int(np.floor(duration * fps + 1e-9)) + 1) / fps)
+    t = np.unique(np.concatenate(times))
+    _, first = np.unique(np.round(t * TICKS_PER_SECOND).astype(np.int64), return_index=True)
+    return t[first]
+
+
+def _curves(scene, node_id, times, values, interpolation):
+    """The three curves of a curve node: key times ``times`` (N,), values (N, 3)."""
+    key_time = np.array([ticks(t) for t in times], dtype=np.int64)
+    flag = _CONSTANT if interpolation == "step" else _LINEAR
+    for axis, name in enumerate("XYZ"):
+        uid, curve = scene.add("AnimationCurve", "", "AnimCurve")
+        column = np.asarray(values[:, axis], dtype=np.float32)
+        curve.add("Default", float(column[0]))
+        curve.add("KeyVer", 4008)
+        curve.add("KeyTime", key_time)
+        curve.add("KeyValueFloat", column)
+        curve.add("KeyAttrFlags", np.array([flag], np.int32))
+        curve.add("KeyAttrDataFloat", np.zeros(4, np.float32))
+        curve.add("KeyAttrRefCount", np.array([len(times)], np.int32))
+        scene.connect(uid, node_id, f"d|{name}")
+
+
+def _track(scene, layer, model, track, duration, unit):
+    times = sample_times(track, duration)
+    values = np.array([track.sample(t) for t in times])
+    if track.channel == "rotation":
+        values = continuous_euler(values)
+    elif track.channel == "translation":
+        values = values * unit
+    short, prop = _CURVE_NODE[track.channel]
+    uid, node = scene.add("AnimationCurveNode", short, "AnimCurveNode")
+    node.append(properties70(*((f"d|{a}", "number", float(values[0, k]))
+                               for k, a in enumerate("XYZ"))))
+    scene.connect(uid, layer)
+    scene.connect(uid, model, prop)
+    _curves(scene, uid, times, values, track.interpolation)
+
+
+def write_clips(scene, clips, joint_ids, skeleton, unit):
+    """An animation stack per clip.
+
+    Parameters
+    ----------
+    scene : rigedit.io.fbx_document.Scene
+    clips : list[rigedit.animation.clip.Clip]
+    joint_ids : list[Int64]
+        Model id of each joint of ``skeleton``.
+    skeleton : rigedit.model.skeleton.Skeleton
+    unit : float
+        File units per metre.
+    """
+    for clip in clips:
+        duration = float(clip.duration)
+        stack, node = scene.add("AnimationStack", clip.name, "AnimStack")
+        span = (ticks(0), ticks(duration))
+        node.append(properties70(("LocalStart", "time", span[0]), ("LocalStop", "time", span[1]),
+                                 ("ReferenceStart", "time", span[0]),
+                                 ("ReferenceStop", "time", span[1])))
+        layer, _ = scene.add("AnimationLayer", "BaseLayer", "AnimLayer")
+        scene.connect(layer, stack)
+        scene.takes.append((clip.name, duration))
+        for (joint, _channel), track in clip.tracks.items():
+            _track(scene, layer, joint_ids[skeleton.index[joint]], track, duration, unit)

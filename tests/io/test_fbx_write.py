@@ -1,0 +1,219 @@
+"""FBX out (rigedit/io/fbx_write.py) read back by ufbx directly, not by rigedit's reader: the
+same skinned vertices at frames of every clip (ufbx's own skinning of the file's clusters),
+the same joints, clips, weights, materials and textures, in centimetres and in metres."""
+import json
+import struct
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import rigedit
+from rigedit.animation.clip import Clip, Track
+from rigedit.cli.main import main
+from rigedit.errors import RigFileError
+from rigedit.io.fbx_binary import Int64, Node, encode
+from rigedit.io.fbx_write import write_fbx
+from rigedit.io.fbx_write_anim import continuous_euler, sample_times
+from testpaths import DATA, TESTS
+
+CESIUM = DATA / "khronos-gltf" / "CesiumMan.glb"
+TOLERANCE = 1e-5     # of the bounding box diagonal
+
+
+def probe(path, times, tmp_path):
+    """What ufbx reads from ``path``: :mod:`ufbx_probe` in a child process (see there)."""
+    spec = tmp_path / f"{path.stem}_times.json"
+    spec.write_text(json.dumps(times))
+    out = tmp_path / f"{path.stem}_probe.npz"
+    run = subprocess.run([sys.executable, str(TESTS / "ufbx_probe.py"), str(path), str(out),
+                          str(spec)], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    with np.load(out) as data:
+        return {k: data[k] for k in data.files}
+
+
+def frames(clip, count=6):
+    """Frame times (30 fps) spread over the clip, its end and two of its own keys."""
+    grid = np.arange(int(np.floor(clip.duration * 30 + 1e-9)) + 1) / 30
+    keys = clip.key_times()
+    keys = keys[(keys >= 0) & (keys <= clip.duration)]
+    picked = grid[np.linspace(0, len(grid) - 1, count).round().astype(int)]
+    return sorted({*map(float, picked), float(clip.duration), *map(float, keys[1:3])})
+
+
+def check_round_trip(rig, path, tmp_path, units="cm"):
+    """Write ``rig`` to ``path`` and compare what ufbx reads to rigedit; returns the probe."""
+    write_fbx(rig.data(), path, units=units)
+    times = {name: frames(clip) for name, clip in rig.clips.items()}
+    got = probe(path, times, tmp_path)
+    lo, hi = rig.bounds()
+    diag = float(np.linalg.norm(hi - lo))
+    sk = rig.skeleton
+    # ufbx lists nodes in an order of its own: compare the trees
+    assert sorted(got["bone_names"]) == sorted(sk.names)
+    assert dict(zip(got["bone_names"], got["bone_parents"])) == \
+        {n: sk.names[p] if p >= 0 else "" for n, p in zip(sk.names, sk.parents)}
+    assert got["original_unit_meters"] == pytest.approx(0.01 if units == "cm" else 1.0)
+    assert sorted(got["stack_names"]) == sorted(rig.clips)
+    for s, name in enumerate(got["stack_names"]):
+        clip = rig.clips[name]
+        assert got["stack_spans"][s] == pytest.approx([0.0, clip.duration], abs=1e-9)
+        for k, t in enumerate(times[name]):
+            ref = rig.skin(clip.sample(t))
+            err = np.abs(got[f"skinned_{s}_{k}"] - ref).max() / diag
+            assert err < TOLERANCE, (name, t, err)
+    np.testing.assert_allclose(got["vertices"], rig.vertices, rtol=0, atol=1e-9 * diag)
+    np.testing.assert_array_equal(got["vertex_indices"], rig.faces.reshape(-1))
+    return got
+
+
+def dense_weights(rig, got):
+    w = np.zeros((len(rig.vertices), len(rig.skeleton)))
+    joints = np.repeat([rig.skeleton.index[b] for b in got["cluster_bones"]],
+                       got["cluster_sizes"])
+    w[got["cluster_vertices"], joints] = got["cluster_weights"]
+    return w
+
+
+@pytest.mark.parametrize("name", ["quadruped", "humanoid"])
+def test_bundled_rigs_read_back_by_ufbx(name, tmp_path):
+    rig = rigedit.load_rig(name)
+    got = check_round_trip(rig, tmp_path / f"{name}.fbx", tmp_path)
+    # one cluster per joint, the weights as bound
+    assert list(got["cluster_bones"]) == rig.skeleton.names
+    np.testing.assert_allclose(dense_weights(rig, got), rig.weights.toarray(), atol=1e-7)
+
+
+def test_cesium_man_with_its_bind_pose_uvs_and_texture(tmp_path):
+    if not CESIUM.exists():
+        pytest.skip(f"missing {CESIUM}")
+    rig = rigedit.load_rig(CESIUM)
+    # CesiumMan is bound elsewhere than its rest pose (Z up): the clusters carry the bind
+    sk = rig.skeleton
+    assert not np.allclose(sk.forward(sk.rest_local_matrices()), sk.bind_matrices, atol=1e-6)
+    got = check_round_trip(rig, tmp_path / "cesium.fbx", tmp_path)
+    uv = got["uv_values"][got["uv_indices"]]
+    expected = rig.surface.uvs[rig.faces.reshape(-1)]
+    np.testing.assert_allclose(uv, np.column_stack([expected[:, 0], 1 - expected[:, 1]]),
+                               atol=1e-12)
+    mat = rig.surface.materials[0]
+    assert list(got["material_names"]) == [mat.name]
+    assert got["texture_content"].tobytes() == mat.image_bytes       # embedded, unchanged
+
+
+def test_centimetres_and_metres_give_the_same_metres(tmp_path):
+    rig = rigedit.load_rig("humanoid")
+    cm = check_round_trip(rig, tmp_path / "cm.fbx", tmp_path, units="cm")
+    m = check_round_trip(rig, tmp_path / "m.fbx", tmp_path, units="m")
+    keys = [k for k in cm if k.startswith(("skinned_", "bones_"))]
+    assert keys
+    for key in keys:
+        np.testing.assert_allclose(cm[key], m[key], rtol=0, atol=1e-6)
+    # and the numbers in the files differ by the unit: the first vertex, in file units
+    raw = {u: (tmp_path / f"{u}.fbx").read_bytes() for u in ("cm", "m")}
+    assert len(raw["cm"]) > 0 and raw["cm"] != raw["m"]
+
+
+def test_step_track_is_held_and_scale_is_keyed(tmp_path):
+    rig = rigedit.load_rig("humanoid")
+    sk = rig.skeleton
+    joint = sk.names[3]
+    rot = Rotation.from_euler("xyz", [[0, 0, 0], [80, 10, 0], [170, -60, 95]], degrees=True)
+    tracks = {(joint, "rotation"): Track("rotation", [0.0, 0.5, 1.0], rot.as_quat(), "step"),
+              (sk.names[1], "scale"): Track("scale", [0.0, 1.0], [[1, 1, 1], [1.3, 0.8, 1.1]]),
+              (sk.names[0], "translation"): Track(
+                  "translation", [0.0, 0.3, 1.0],
+                  sk.rest_translation[0] + [[0, 0, 0], [0.1, 0.05, 0], [0.2, 0, 0.1]],
+                  "catmull_rom")}
+    rig.clips = {"test": Clip("test", sk, tracks, duration=1.0, loop=False)}
+    path = tmp_path / "step.fbx"
+    write_fbx(rig.data(), path)
+    times = [0.0, 0.2, 0.49, 0.51, 0.75, 0.99, 1.0, 13 / 30]
+    got = probe(path, {"test": times}, tmp_path)
+    lo, hi = rig.bounds()
+    diag = np.linalg.norm(hi - lo)
+    for k, t in enumerate(times):
+        ref = rig.skin(rig.clips["test"].sample(t))
+        err = np.abs(got[f"skinned_0_{k}"] - ref).max() / diag
+        # between frames the catmull-rom translation is linear in FBX: 13/30 is a frame
+        limit = TOLERANCE if t in (0.0, 1.0, 13 / 30) else 1e-3
+        assert err < limit, (t, err)
+
+
+def test_continuous_euler_takes_the_short_way():
+    # a turn through gimbal lock and across +-180 degrees on every axis
+    rng = np.random.default_rng(7)
+    steps = Rotation.from_rotvec(rng.normal(scale=0.15, size=(400, 3)))
+    q = np.empty((401, 4))
+    q[0] = [0, 0, 0, 1]
+    r = Rotation.identity()
+    for i, s in enumerate(steps):
+        r = s * r
+        q[i + 1] = r.as_quat()
+    e = continuous_euler(q)
+    # the same rotations
+    back = Rotation.from_euler("xyz", e, degrees=True)
+    assert np.allclose(np.abs(np.sum(back.as_quat() * q, axis=1)), 1, atol=1e-9)
+    # each row is the one of its equivalent triples (twin, whole turns) nearest the row before
+    prev, cur = e[:-1], e[1:]
+    twin = np.column_stack([cur[:, 0] + 180, 180 - cur[:, 1], cur[:, 2] + 180])
+    best = np.minimum(*(np.abs((c - prev + 180) % 360 - 180).sum(axis=1) for c in (cur, twin)))
+    np.testing.assert_allclose(np.abs(cur - prev).sum(axis=1), best, atol=1e-9)
+    assert np.abs(e).max() > 180          # it did unwrap past the principal range
+
+
+def test_sample_times():
+    track = Track("rotation", [0.05, 0.5], [[0, 0, 0, 1], [0, 0.6, 0, 0.8]])
+    t = sample_times(track, 1.0)
+    assert np.all(np.isin(np.arange(31) / 30, t)) and 0.05 in t
+    vec = Track("translation", [0.05, 0.5, 2.0], np.zeros((3, 3)))
+    assert list(sample_times(vec, 1.0)) == [0.0, 0.05, 0.5, 1.0]
+
+
+def test_binary_container_layout():
+    root = Node("Top", Int64(7), "name\x00\x01Model", 1.5, True)
+    root.add("Child", np.arange(100, dtype=np.float64))     # 800 bytes: compressed
+    root.add("Empty")
+    blob = encode([root, Node("Last", 3)])
+    assert blob[:27] == b"Kaydara FBX Binary  \x00\x1a\x00" + struct.pack("<I", 7400)
+    end, count, length, name_len = struct.unpack_from("<IIIB", blob, 27)
+    assert (count, name_len, blob[40:43]) == (4, 3, b"Top")
+    assert blob[43:44] == b"L" and struct.unpack_from("<q", blob, 44)[0] == 7
+    assert blob[end - 13:end] == bytes(13)              # the null record after the children
+    child = 43 + length
+    child_end, _, _, _ = struct.unpack_from("<IIIB", blob, child)
+    code = blob[child + 13 + 5:child + 13 + 6]
+    n, encoding, stored = struct.unpack_from("<III", blob, child + 19)
+    assert (code, n, encoding) == (b"d", 100, 1) and stored < 800
+    # footer: the version again and the closing id at the very end
+    assert struct.unpack_from("<I", blob, len(blob) - 140)[0] == 7400
+    assert blob[-16:] == bytes.fromhex("f85a8c6adef5d97eece90ce3758f290b")
+    assert (len(blob) - 140) % 16 == 0
+
+
+def test_save_by_suffix_and_errors(tmp_path):
+    rig = rigedit.load_rig("humanoid")
+    out = rig.save(tmp_path / "h.fbx", clips=["wave"])
+    assert out.read_bytes().startswith(b"Kaydara FBX Binary")
+    assert list(tmp_path.iterdir()) == [out]               # atomic: no temporary left
+    with pytest.raises(RigFileError, match="h2.fbx.*clip"):
+        write_fbx(rig.data(), tmp_path / "h2.fbx", clips=["nope"])
+    with pytest.raises(RigFileError, match="units"):
+        write_fbx(rig.data(), tmp_path / "h2.fbx", units="inch")
+    with pytest.raises(RigFileError, match="no folder"):
+        write_fbx(rig.data(), tmp_path / "missing" / "h.fbx")
+    with pytest.raises(RigFileError, match=r"\.fbx file name"):
+        write_fbx(rig.data(), tmp_path / "h.obj")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["h.fbx"]
+
+
+def test_cli_export_fbx_units(tmp_path, capsys):
+    assert main(["export", "humanoid", "-o", str(tmp_path / "m.fbx"), "--fbx-units", "m",
+                 "--clip", "walk"]) == 0
+    assert "clips: walk" in capsys.readouterr().out
+    got = probe(tmp_path / "m.fbx", {"walk": [0.5]}, tmp_path)
+    assert got["original_unit_meters"] == pytest.approx(1.0)
+    assert list(got["stack_names"]) == ["walk"]
