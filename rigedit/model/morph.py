@@ -42,10 +42,12 @@ class MorphTargets:
     _rows: list = field(default_factory=list, init=False, repr=False)
     _sparse: list = field(default_factory=list, init=False, repr=False)
     _sparse_n: list = field(default_factory=list, init=False, repr=False)
+    _slot: dict = field(default_factory=dict, init=False, repr=False)   # name -> index
 
     def __post_init__(self):
         self.names = tuple(str(n) for n in self.names)
-        if len(set(self.names)) != len(self.names):
+        self._slot = {name: m for m, name in enumerate(self.names)}
+        if len(self._slot) != len(self.names):
             raise ValueError(f"morph target names are not unique: {self.names}")
         self.deltas = np.ascontiguousarray(self.deltas, dtype=np.float32)
         if self.deltas.ndim != 3 or self.deltas.shape[2] != 3 \
@@ -95,10 +97,7 @@ class MorphTargets:
 
     def index(self, name) -> int:
         """The position of target ``name`` in :attr:`names` (KeyError if none)."""
-        try:
-            return self.names.index(name)
-        except ValueError:
-            raise KeyError(name) from None
+        return self._slot[name]
 
     def moved_rows(self, m) -> np.ndarray:
         """(n,) int64: the vertices target ``m`` moves."""
@@ -117,9 +116,11 @@ class MorphTargets:
             return self.default_weights.copy()
         if isinstance(weights, dict):
             out = self.default_weights.copy()
+            slot = self._slot
             for name, w in weights.items():
-                if name in self.names:
-                    out[self.names.index(name)] = float(w)
+                m = slot.get(name)
+                if m is not None:
+                    out[m] = float(w)
             return out
         out = np.asarray(weights, dtype=np.float64).reshape(-1)
         if out.shape != (self.count,):
