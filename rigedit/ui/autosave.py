@@ -20,7 +20,7 @@ import threading
 
 from PyQt5 import QtCore, QtWidgets
 
-from ..editor import recovery
+from ..editor import events as ev, recovery
 from ..errors import RigFileError
 from . import errors_hook
 
@@ -87,7 +87,7 @@ class Autosave(QtCore.QObject):
         self._written_in_thread.connect(self._thread_signalled)
         self.timer = QtCore.QTimer(self)
         self.timer.timeout.connect(self.tick)
-        document.subscribe(self._on_document)
+        document.listen(self._on_event)
         self.set_interval(_interval_from_env() if interval is None else interval)
 
     def set_interval(self, seconds):
@@ -96,9 +96,9 @@ class Autosave(QtCore.QObject):
         if self.interval > 0:
             self.timer.start(int(round(self.interval * 1000)))
 
-    def _on_document(self, event, **info):
+    def _on_event(self, event):
         # Saved, or undone back to the saved state: nothing to recover any more.
-        if event == "undo" and not self.document.modified and self.folder.exists():
+        if isinstance(event, ev.UndoChanged) and not self.document.modified and self.folder.exists():
             self.discard()
 
     def tick(self):

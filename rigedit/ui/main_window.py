@@ -10,12 +10,14 @@ part               module
 3D view            :mod:`.scene_view` (plotter, scene, spheres, axis handles, drags)
 view options       :mod:`.view_actions` (View menu, tool bar, pose / edit mode)
 Edit menu          :mod:`.edit_actions` (undo, redo, reset, mirror)
-docks              :mod:`.panels` (joints, info), :mod:`.timeline` (playback, keys, clips)
+docks              :mod:`.panels` (joints, info), :mod:`.timeline` (playback, keys, clips),
+                   :mod:`.morph_panel` (shapes)
 File menu          :mod:`.file_actions`, :mod:`.autorig_dialog`, :mod:`.reembed`,
                    :mod:`.import_motion`, :mod:`.record_dialog`, :mod:`.weight_tools`
 jobs               :mod:`.jobs` (progress bar, Cancel), :mod:`.rebind` (edit-mode re-binds)
 weight brush       :mod:`.weight_brush`
-safety             :mod:`.autosave`, :mod:`.errors_hook`, :mod:`.proxy_view` (big meshes)
+messages           :mod:`.messages` (status line, errors), :mod:`.errors_hook` (bugs)
+safety             :mod:`.autosave` (recovery), :mod:`.proxy_view` (big meshes)
 =================  ==========================================================================
 """
 from __future__ import annotations

@@ -14,6 +14,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 from PyQt5 import QtCore, QtWidgets
 
+from ..editor import events as ev
 from ..render.proxy import PROXY_MIN_FACES, build_proxy
 
 __all__ = ["ProxyView"]
@@ -59,7 +60,7 @@ class ProxyView:
         self._poll = QtCore.QTimer(status_bar)
         self._poll.setInterval(100)
         self._poll.timeout.connect(self._collect)
-        document.subscribe(self._on_document)
+        document.listen(self._on_event)
         self.attach()
 
     @property
@@ -94,16 +95,16 @@ class ProxyView:
             self.scene_source().attach_proxy(proxy.rebind(self.document.rig.binding))
         self._show_label()
 
-    def _on_document(self, event, **info):
+    def _on_event(self, event):
         scene = self.scene_source()
-        if event == "rig":
+        if isinstance(event, ev.RigReplaced):
             self.attach()
         elif scene.proxy is None:
             return
-        elif event == "rest":   # a re-bind: the proxy takes the new weights
+        elif isinstance(event, (ev.RestChanged, ev.WeightsChanged)):   # new weights
             scene.attach_proxy(scene.proxy.rebind(self.document.rig.binding))
             self._show_label()
-        elif event == "pose":
+        elif isinstance(event, ev.PoseChanged):
             if self.weights_view():
                 self._settle()
                 return

@@ -21,6 +21,7 @@ import numpy as np
 from PyQt5 import QtWidgets
 
 from ..binding.weight_paint import mirror_vertices, vertex_adjacency
+from ..editor import events as ev
 from ..render.brush_circle import BrushCircle
 from ..render.observers import add_mouse_observers
 from ..render.surface_pick import SurfacePicker, nearest_vertex, world_radius
@@ -96,7 +97,7 @@ class WeightBrush:
         self._passive = [tag, iren.AddObserver("LeaveEvent", self._leave)]
         panel.lock_toggled.connect(self._lock_selected)
         self._build_action(services.parent)
-        document.subscribe(self._on_document)
+        document.listen(self._on_event)
         self._attach()
 
     def _build_action(self, parent):
@@ -130,8 +131,8 @@ class WeightBrush:
         self._picker.reset()
         self._cache = {}
 
-    def _on_document(self, event, **info):
-        if event == "rig":
+    def _on_event(self, event):
+        if isinstance(event, ev.RigReplaced):
             self.cancel()
             self.locked = set()
             self._attach()
@@ -140,7 +141,7 @@ class WeightBrush:
                 self.set_enabled(False)
             self.action.setEnabled(self.view.scene.has_mesh)
             self._show_lock()
-        elif event == "selection":
+        elif isinstance(event, ev.SelectionChanged):
             self._show_lock()
 
     # ------------------------------------------------------------------ settings

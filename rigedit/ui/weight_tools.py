@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from PyQt5 import QtWidgets
 
+from ..editor import events as ev
 # the flag's edit is the editor's (no Qt); kept importable from here
 from ..editor.deform import set_joint_deform, skeleton_with_deform
 
@@ -54,15 +55,15 @@ class WeightTools:
             act.triggered.connect(lambda _=False, m=method: recompute_weights(m))
             self.recompute_actions[method] = act
         joint_panel.deform_toggled.connect(lambda j, on: set_joint_deform(document, j, on))
-        document.subscribe(self._on_document)
-        self._on_document("rig")
+        document.listen(self._on_event)
+        self._on_event(ev.RigReplaced())
 
     def actions(self):
         """name -> QAction or QMenu for :func:`.menus.build_menus`."""
         return {"dqs": self.dqs_action, "recompute_with": self.recompute_menu}
 
-    def _on_document(self, event, **_):
-        if event != "rig":
+    def _on_event(self, event):
+        if not isinstance(event, ev.RigReplaced):
             return
         method = "dqs" if self.dqs_action.isChecked() else "lbs"
         if self.view.scene.skinning != method:   # a new scene keeps the chosen skinning
