@@ -172,7 +172,10 @@ def _influences(mesh, joint_of, path):
 def _notes(settings):
     unit = float(settings.original_unit_meters)
     axes = axes_text(settings.axes)
-    units = (f"{unit * 100:g} cm per file unit (UnitScaleFactor), converted to metres"
+    named = {0.001: "millimetres", 0.01: "centimetres", 0.0254: "inches", 0.1: "decimetres",
+             0.3048: "feet", 1.0: "metres", 1000.0: "kilometres"}
+    name = next((v for k, v in named.items() if abs(unit - k) <= 1e-9 * k), f"{unit:g} m")
+    units = (f"file in {name} (UnitScaleFactor {unit * 100:g}), converted to metres"
              if unit > 0 else "no unit stated; read as metres")
     frames = (f"file axes {axes}; converted to Y up, +Z forward" if axes !=
               "+X right, +Y up, +Z front" else "file axes +X right, +Y up, +Z front: "
