@@ -133,7 +133,7 @@ def test_mixamo_skeleton_weights_and_clips():
     # centimetres in the file, metres here: a 1.8 m character standing on the ground
     height = data.vertices[:, 1].max() - data.vertices[:, 1].min()
     assert 1.7 < height < 1.9 and abs(data.vertices[:, 1].min()) < 0.01
-    assert "cm" in data.meta.notes["units"] and data.meta.format == "fbx"
+    assert "centimetres" in data.meta.notes["units"] and data.meta.format == "fbx"
     assert set(data.clips) == {"Take 001", "mixamo.com"}
     clip = data.clips["mixamo.com"]
     assert abs(clip.duration - 16.8333) < 1e-3 and len(clip.tracks) > 60
