@@ -1,8 +1,10 @@
-"""The runtime model: transforms, skeleton, pose, kinematics, IK, skinning (LBS, DQS).
+"""The runtime model: transforms, skeleton, pose, kinematics, IK, morph targets, skinning
+(LBS, DQS).
 
 Imports numpy and scipy only (no Qt, VTK or pyvista).
 """
 from .kinematics import local_to_model, skinning_matrices
+from .morph import MorphTargets
 from .pose import Pose
 from .skeleton import Skeleton, topological_order
 from .skinning import SkinBinding, dense_weights, linear_blend_skin, top_k_influences
@@ -10,7 +12,8 @@ from .transforms import compose_trs, decompose_trs, euler_to_quat, quat_to_euler
 
 __all__ = ["Skeleton", "Pose", "SkinBinding", "local_to_model", "skinning_matrices",
            "linear_blend_skin", "top_k_influences", "dense_weights", "compose_trs",
-           "decompose_trs", "euler_to_quat", "quat_to_euler", "topological_order"]
+           "decompose_trs", "euler_to_quat", "quat_to_euler", "topological_order",
+           "MorphTargets"]
 
 
 def __getattr__(name):
