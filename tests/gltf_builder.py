@@ -345,3 +345,52 @@ def two_skins_and_parts(conflict=True):
                      {"sampler": 1, "target": {"node": 4, "path": "rotation"}}]}]
     count = 8 + 4 + 4 + 8 + 8 + 4
     return b, {"vertices": count, "S": s_off}
+
+
+def morph_bar(interpolation="LINEAR", names=("smile", "frown")):
+    """:func:`two_bone`'s bar with two morph targets and a clip keying their weights.
+
+    Target 0 moves every vertex (dense), target 1 moves two (a sparse accessor) and has
+    NORMAL deltas. ``mesh.weights`` is (0.1, 0.2); the ``bend`` clip keys the weights at 0,
+    0.5 and 1 s: (0, 0), (0.3, 0.7), (1, 0.25), with ``interpolation`` (CUBICSPLINE with
+    in-/out-tangents of its own). ``names`` None: no ``extras.targetNames``.
+
+    Returns
+    -------
+    builder : GltfBuilder
+    expected : dict of two_bone's plus "deltas" (2, 8, 3)
+    """
+    b, expected = two_bone()
+    prim = b.doc["meshes"][0]["primitives"][0]
+    d0 = np.stack([np.zeros(8), np.zeros(8), np.linspace(0, 0.2, 8)], 1)
+    d1 = np.zeros((8, 3))
+    d1[[3, 6]] = [[0.05, 0.0, 0.0], [0.0, 0.1, -0.05]]
+    n1 = np.zeros((8, 3))
+    n1[[3, 6]] = [[0.5, 0.0, 0.0], [0.0, 0.5, 0.0]]
+    t0 = {"POSITION": b.accessor(d0, "float32", minmax=True)}
+    base = b.accessor(np.zeros((8, 3)), "float32")
+    b.sparse(base, [3, 6], d1[[3, 6]])
+    b.doc["accessors"][base].pop("bufferView")
+    b.doc["accessors"][base].pop("byteOffset")
+    b.doc["accessors"][base].update(min=d1.min(0).tolist(), max=d1.max(0).tolist())
+    t1 = {"POSITION": base, "NORMAL": b.accessor(n1, "float32")}
+    prim["targets"] = [t0, t1]
+    mesh = b.doc["meshes"][0]
+    mesh["weights"] = [0.1, 0.2]
+    if names is not None:
+        mesh["extras"] = {"targetNames": list(names)}
+    times = np.array([0.0, 0.5, 1.0])
+    values = np.array([[0.0, 0.0], [0.3, 0.7], [1.0, 0.25]])
+    if interpolation == "CUBICSPLINE":
+        tangents = np.array([[0.5, -0.2], [1.0, 0.4], [-0.3, 0.0]])
+        out = np.stack([tangents, values, -tangents], axis=1)
+    else:
+        out = values
+    anim = b.doc["animations"][0]
+    anim["samplers"].append({"input": b.accessor(times, "float32", minmax=True),
+                             "output": b.accessor(out.reshape(-1, 1), "float32"),
+                             "interpolation": interpolation})
+    mesh_node = next(i for i, n in enumerate(b.doc["nodes"]) if n.get("mesh") == 0)
+    anim["channels"].append({"sampler": len(anim["samplers"]) - 1,
+                             "target": {"node": mesh_node, "path": "weights"}})
+    return b, dict(expected, deltas=np.stack([d0, d1]), normal_deltas=np.stack([np.zeros((8, 3)), n1]))

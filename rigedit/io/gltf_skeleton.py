@@ -254,11 +254,23 @@ def bind_skins(data, skeleton, smap, skins):
     except np.linalg.LinAlgError:
         raise RigFileError(data.path, "expected invertible inverse bind matrices, got a "
                                       "singular one") from None
-    out = Skeleton(names, parents, np.r_[sk.rest_translation, np.zeros((extra, 3))],
-                   np.r_[sk.rest_rotation, np.tile([0.0, 0, 0, 1], (extra, 1))],
-                   np.r_[sk.rest_scale, np.ones((extra, 3))], bind_matrices=bind,
-                   tails=np.r_[sk.tails, np.full((extra, 3), np.nan)],
-                   deform=np.r_[sk.deform, np.ones(extra, bool)])
+    # parent-before-child as a file written from this skeleton reads back (depth first)
+    order = np.array(topological_order(names, [names[p] if p >= 0 else None
+                                               for p in parents]), dtype=np.int64)
+    new = np.empty_like(order)
+    new[order] = np.arange(len(order))
+    smap.nodes = [smap.nodes[i] for i in order]
+    smap.prefix = [smap.prefix[i] for i in order]
+    smap.of_node = {n: j for j, n in enumerate(smap.nodes) if n >= 0}
+    smap.skin_to_joint = {s: new[m] for s, m in smap.skin_to_joint.items()}
+    parents = [-1 if parents[i] < 0 else int(new[parents[i]]) for i in order]
+    inverse, bind = inverse[order], bind[order]
+    out = Skeleton([names[i] for i in order], parents,
+                   np.r_[sk.rest_translation, np.zeros((extra, 3))][order],
+                   np.r_[sk.rest_rotation, np.tile([0.0, 0, 0, 1], (extra, 1))][order],
+                   np.r_[sk.rest_scale, np.ones((extra, 3))][order], bind_matrices=bind,
+                   tails=np.r_[sk.tails, np.full((extra, 3), np.nan)][order],
+                   deform=np.r_[sk.deform, np.ones(extra, bool)][order])
     out.inverse_bind_matrices = inverse   # the file's values as given, not inverted twice
     return out, extra
 

@@ -11,7 +11,10 @@ CUBICSPLINE, and ``nlerp``/``hybrid`` (which glTF cannot express) resampled: eac
 interval is cut into pieces of at most :data:`RESAMPLE_DEGREES` so that LINEAR (slerp) between
 the samples stays within about 1e-6 rad of the original curve. A clip's duration and loop flag
 go into the animation's ``extras``, a joint's tail and deform flag into its node's, and are
-read back by rigedit.
+read back by rigedit. Morph targets and weight tracks: :mod:`rigedit.io.gltf_write_morph`.
+Rigid parts that came in (meshes under a joint node) go out as primitives of the one skinned
+mesh, each vertex bound wholly to its joint, in bind space: the same placement at every
+frame.
 
 The container is written here rather than through pygltflib because the writer needs exact
 control of padding and of which fields appear (the Khronos validator flags stray defaults).
@@ -30,6 +33,7 @@ import scipy.sparse as sp
 from ..errors import RigFileError
 from .atomic import atomic_write
 from .data import as_rig_data
+from .gltf_write_morph import mesh_morph_fields, primitive_targets, weights_sampler
 
 __all__ = ["save_gltf", "RESAMPLE_DEGREES"]
 
@@ -158,13 +162,18 @@ def _mesh(w, rig):
             attrs[f"WEIGHTS_{s}"] = w.accessor(weights[sel, 4 * s:4 * s + 4], vertex=True,
                                                target=34962)
         prim = {"attributes": attrs, "mode": 4}
+        if rig.morphs is not None:
+            prim["targets"] = primitive_targets(w, rig.morphs, sel)
         if len(tri):
             itype = _USHORT if len(sel) <= 65535 else _UINT
             prim["indices"] = w.accessor(tri.reshape(-1, 1), itype, target=34963)
         if prim_mat[p] >= 0:
             prim["material"] = materials[int(prim_mat[p])]
         primitives.append(prim)
-    return w.add("meshes", {"name": rig.name, "primitives": primitives})
+    mesh = {"name": rig.name, "primitives": primitives}
+    if rig.morphs is not None:
+        mesh.update(mesh_morph_fields(rig.morphs))
+    return w.add("meshes", mesh)
 
 
 def _materials(w, surf):
@@ -261,7 +270,19 @@ def _track_sampler(w, tr):
             "output": w.accessor(values), "interpolation": kind}
 
 
-def _animations(w, rig, joints, clips):
+def _weights_channel(w, rig, clip, mesh_node, samplers, channels):
+    """Append the clip's morph weight channel (on the mesh node), if it has one."""
+    got = None if rig.morphs is None or mesh_node is None else weights_sampler(clip, rig.morphs)
+    if got is None:
+        return
+    times, out, mode = got
+    samplers.append({"input": w.accessor(_float32_times(times)[:, None], minmax=True),
+                     "output": w.accessor(out[:, None]), "interpolation": mode})
+    channels.append({"sampler": len(samplers) - 1,
+                     "target": {"node": mesh_node, "path": "weights"}})
+
+
+def _animations(w, rig, joints, clips, mesh_node=None):
     names = list(rig.clips) if clips is None else list(clips)
     for name in names:
         if name not in rig.clips:
@@ -277,6 +298,7 @@ def _animations(w, rig, joints, clips):
             channels.append({"sampler": len(samplers) - 1,
                              "target": {"node": joints[clip.skeleton.index[joint]],
                                         "path": channel}})
+        _weights_channel(w, rig, clip, mesh_node, samplers, channels)
         if channels:
             w.add("animations", {"name": name, "samplers": samplers, "channels": channels,
                                  "extras": {"rigedit": {"duration": clip.duration,
@@ -295,12 +317,13 @@ def gltf_bytes(rig, binary=True, clips=None):
     if len(roots) == 1:
         skin["skeleton"] = roots[0]
     w.add("skins", skin)
-    scene = list(roots)
+    scene, mesh_node = list(roots), None
     if mesh is not None:  # at the scene root, no transform: the spec ignores it anyway
-        scene.insert(0, w.add("nodes", {"name": rig.name, "mesh": mesh, "skin": 0}))
+        mesh_node = w.add("nodes", {"name": rig.name, "mesh": mesh, "skin": 0})
+        scene.insert(0, mesh_node)
     w.doc["scenes"] = [{"nodes": scene}]
     w.doc["scene"] = 0
-    _animations(w, rig, joints, clips)
+    _animations(w, rig, joints, clips, mesh_node)
     w.blob += bytes((-len(w.blob)) % 4)
     w.doc["buffers"] = [{"byteLength": len(w.blob)}]
     if not binary:

@@ -101,9 +101,12 @@ def test_two_skins_and_rigid_parts_skin_like_the_spec(tmp_path, conflict):
     data = read_gltf(path)
     assert len(data.vertices) == info["vertices"]
     names = data.skeleton.names
-    # one skeleton: the union of the three skins' joints, the root first
-    assert names[:4] == ["hips", "spine", "head", "leg"]
+    # one skeleton: the union of the three skins' joints, the root first, and where skin 2's
+    # head bind differs from skin 0's, a helper joint under the head that carries it
+    assert names[0] == "hips" and set(names) - {"head.skin2"} == {"hips", "spine", "head", "leg"}
     assert ("head.skin2" in names) == conflict
+    if conflict:
+        assert data.skeleton.parents[names.index("head.skin2")] == names.index("head")
     assert int(np.sum(data.skeleton.parents < 0)) == 1
     assert "skins" in data.meta.notes and "parts" in data.meta.notes
     assert "pre-transformed" in data.meta.notes["skins"]
@@ -162,3 +165,32 @@ def test_robot_expressive_skins_like_the_spec():
     # the walk and the wave (its face keys the three shapes) at a few times
     assert rig.clips["Wave"].morph_tracks
     assert worst(path, rig, times=(0.0, 0.37, 1.1), clips=["Walking", "Wave"]) < 1e-5
+
+
+@pytest.mark.parametrize("trees", [1, 2])
+def test_rigid_parts_and_skins_export_back_the_same_way(tmp_path, trees):
+    from rigedit.io.gltf_write import save_gltf
+    from test_gltf_morph import _validate
+
+    b, _ = two_skins_and_parts()
+    if trees == 2:   # a second tree: the static base carried by an animated node of its own
+        b.doc["animations"][0]["channels"].append(
+            {"sampler": 1, "target": {"node": 8, "path": "rotation"}})
+    path = b.write(tmp_path / "figure.glb")
+    first = Rig.from_data(read_gltf(path))
+    assert int(np.sum(first.skeleton.parents < 0)) == trees
+    assert worst(path, first) < 1e-6
+    out = save_gltf(first, tmp_path / "again.glb")
+    again = Rig.from_data(read_gltf(out))
+    assert again.skeleton.names == first.skeleton.names
+    assert int(np.sum(again.skeleton.parents < 0)) == trees
+    # the rigid parts went out as skinned primitives, each vertex wholly on its joint
+    g = Reference(out).g
+    assert len(g.meshes[0].primitives) == len(set(first.surface.vertex_primitive.tolist()))
+    hat = np.flatnonzero(first.surface.vertex_primitive == 2)
+    dense = again.binding.dense()
+    assert np.all(dense[hat, first.skeleton.names.index("head")] == 1)
+    clip_a, clip_b = first.clips["move"], again.clips["move"]
+    for t in (0.0, 0.3, 0.5, 1.0):
+        assert np.abs(first.skin(clip_a.sample(t)) - again.skin(clip_b.sample(t))).max() < 1e-6
+    _validate(out)
