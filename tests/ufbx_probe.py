@@ -36,8 +36,10 @@ def _vec3(values):
 def probe(path, times):
     scene = kept(ufbx.load_file(path, target_unit_meters=1.0,
                            space_conversion=ufbx.SpaceConversion.MODIFY_GEOMETRY))
-    out = {"unit_meters": scene.settings.unit_meters,
-           "original_unit_meters": scene.settings.original_unit_meters}
+    settings = kept(scene.settings)
+    out = {"unit_meters": settings.unit_meters,
+           "original_unit_meters": settings.original_unit_meters,
+           "up_axis": int(kept(settings.axes).up)}
     bones = kept([n for n in kept(list(scene.nodes)) if kept(n.bone) is not None])
     out["bone_names"] = np.array([n.name for n in bones])
     parents = kept([kept(n.parent) for n in bones])
@@ -70,8 +72,9 @@ def probe(path, times):
         for k, t in enumerate(times.get(stack.name, [])):
             evaluated = kept(scene.evaluate(kept(stack.anim), float(t),
                                             evaluate_skinning=True))
-            skinned = kept(kept(kept(evaluated.meshes[0]).skinned_position).values)
-            out[f"skinned_{s}_{k}"] = _vec3(skinned)
+            if len(kept(evaluated.meshes)):
+                skinned = kept(kept(kept(evaluated.meshes[0]).skinned_position).values)
+                out[f"skinned_{s}_{k}"] = _vec3(skinned)
             nodes = kept(list(evaluated.nodes))
             out[f"bones_{s}_{k}"] = np.array(
                 [tuple(nodes[n.typed_id].node_to_world.c3) for n in bones]).reshape(-1, 3)

@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model.transforms import quat_to_euler
 from .fbx_document import TICKS_PER_SECOND, properties70, ticks
+from .fbx_write_skin import euler_degrees
 
 __all__ = ["write_clips", "continuous_euler", "sample_times", "FPS"]
 
@@ -48,7 +48,7 @@ def continuous_euler(quats):
     that one, so the parities are a cumulative xor of neighbour comparisons, and the whole
     turns a cumulative sum of wrapped differences: no Python loop over the keys.
     """
-    e = quat_to_euler(np.asarray(quats, dtype=np.float64), degrees=True).reshape(-1, 3)
+    e = euler_degrees(quats)
     if len(e) < 2:
         return e
     twin = np.column_stack([e[:, 0] + 180.0, 180.0 - e[:, 1], e[:, 2] + 180.0])

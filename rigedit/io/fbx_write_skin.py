@@ -13,6 +13,8 @@ matrices.
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -20,7 +22,17 @@ from ..model.transforms import quat_to_euler
 from .fbx_binary import Int64, Node
 from .fbx_document import properties70
 
-__all__ = ["write_skeleton", "write_skin", "write_bind_pose", "fbx_matrix", "add_model"]
+__all__ = ["write_skeleton", "write_skin", "write_bind_pose", "fbx_matrix", "add_model",
+           "euler_degrees"]
+
+
+def euler_degrees(quats):
+    """(N, 4) quaternions (x, y, z, w) -> (N, 3) Euler XYZ degrees (matrix Rz·Ry·Rx, FBX's
+    ``eEulerXYZ``). At gimbal lock SciPy warns and sets the third angle to zero: the triple
+    is still the same rotation, so the warning is not the user's business."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "Gimbal lock", UserWarning)
+        return quat_to_euler(np.asarray(quats, dtype=np.float64).reshape(-1, 4), degrees=True)
 
 
 def fbx_matrix(mat, unit):
@@ -31,14 +43,14 @@ def fbx_matrix(mat, unit):
     return np.ascontiguousarray(m.T).reshape(16)
 
 
-def add_model(scene, name, subtype, translation, euler_degrees, scale):
+def add_model(scene, name, subtype, translation, euler, scale):
     """A new ``Model`` (``LimbNode``, ``Mesh``) at a local transform (translation in file
     units, rotation Euler XYZ degrees); returns its id."""
     uid, model = scene.add("Model", name, "Model", subtype)
     model.add("Version", 232)
     model.append(properties70(("InheritType", "enum", 1), ("DefaultAttributeIndex", "int", 0),
                               ("Lcl Translation", "lcl_t", *map(float, translation)),
-                              ("Lcl Rotation", "lcl_r", *map(float, euler_degrees)),
+                              ("Lcl Rotation", "lcl_r", *map(float, euler)),
                               ("Lcl Scaling", "lcl_s", *map(float, scale))))
     model.add("Shading", True)
     model.add("Culling", "CullingOff")
@@ -60,7 +72,7 @@ def write_skeleton(scene, skeleton, unit):
     ids : list[Int64]
         The model id of each joint.
     """
-    euler = quat_to_euler(skeleton.rest_rotation, degrees=True)
+    euler = euler_degrees(skeleton.rest_rotation)
     ids = []
     for j, name in enumerate(skeleton.names):
         uid = add_model(scene, name, "LimbNode", skeleton.rest_translation[j] * unit, euler[j],

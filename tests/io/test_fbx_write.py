@@ -14,9 +14,13 @@ import rigedit
 from rigedit.animation.clip import Clip, Track
 from rigedit.cli.main import main
 from rigedit.errors import RigFileError
+from rigedit.io.data import RigData
 from rigedit.io.fbx_binary import Int64, Node, encode
 from rigedit.io.fbx_write import write_fbx
 from rigedit.io.fbx_write_anim import continuous_euler, sample_times
+from rigedit.model.kinematics import local_to_model
+from rigedit.model.skeleton import Skeleton
+from builders import chain_skeleton
 from testpaths import DATA, TESTS
 
 CESIUM = DATA / "khronos-gltf" / "CesiumMan.glb"
@@ -217,3 +221,44 @@ def test_cli_export_fbx_units(tmp_path, capsys):
     got = probe(tmp_path / "m.fbx", {"walk": [0.5]}, tmp_path)
     assert got["original_unit_meters"] == pytest.approx(1.0)
     assert list(got["stack_names"]) == ["walk"]
+
+
+def test_round_trip_through_rigedits_reader(tmp_path):
+    """rigedit's own FBX reader (rigedit/io/fbx_read.py) gives back the rig: same joints,
+    clips and skinned vertices at every frame of every clip."""
+    rig = rigedit.load_rig("quadruped")
+    back = rigedit.load_rig(write_fbx(rig.data(), tmp_path / "q.fbx"))
+    assert back.skeleton.names == rig.skeleton.names
+    assert sorted(back.clips) == sorted(rig.clips)
+    lo, hi = rig.bounds()
+    diag = np.linalg.norm(hi - lo)
+    for name, clip in rig.clips.items():
+        assert back.clips[name].duration == pytest.approx(clip.duration, abs=1e-9)
+        for t in np.arange(0, clip.duration + 1e-9, 1 / 30):
+            err = np.abs(back.skin(back.clips[name].sample(t)) - rig.skin(clip.sample(t)))
+            assert err.max() / diag < TOLERANCE, (name, t)
+
+
+def test_skeleton_without_mesh_z_up_and_scaled_joints(tmp_path):
+    """A BVH-like rig (no mesh), declared Z up (ufbx, asked for no conversion, keeps the
+    numbers), with a non-uniform scale under a rotated parent (InheritType 1 composes it as
+    rigedit does): ufbx's joint positions match at every time asked."""
+    chain = chain_skeleton(4, 0.5)
+    rotation, scale = chain.rest_rotation.copy(), chain.rest_scale.copy()
+    rotation[1] = Rotation.from_euler("z", 30, degrees=True).as_quat()
+    scale[1] = [1.5, 0.7, 1.0]
+    sk = Skeleton(chain.names, chain.parents, chain.rest_translation, rotation, scale)
+    q = Rotation.from_euler("xyz", [[0, 0, 0], [40, 0, 200], [0, 90, 0]], degrees=True)
+    clip = Clip("swing", sk, {("j2", "rotation"): Track("rotation", [0, 0.5, 1], q.as_quat()),
+                              ("j1", "scale"): Track("scale", [0, 1], [[1.5, 0.7, 1], [1, 2, 1]])})
+    data = RigData(sk, np.zeros((0, 3)), np.zeros((0, 3)), clips={"swing": clip}, name="chain",
+                   up="z")
+    path = tmp_path / "chain.fbx"
+    write_fbx(data, path)
+    times = [0.0, 0.3, 0.5, 1.0]
+    got = probe(path, {"swing": times}, tmp_path)
+    order = [list(got["bone_names"]).index(n) for n in sk.names]
+    for k, t in enumerate(times):
+        ref = local_to_model(sk, clip.sample(t))[:, :3, 3]
+        np.testing.assert_allclose(got[f"bones_0_{k}"][order], ref, atol=1e-6)
+    assert got["up_axis"] == 4      # ufbx.CoordinateAxis.POSITIVE_Z: the data stays as it is
