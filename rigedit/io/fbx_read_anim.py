@@ -2,7 +2,8 @@
 
 ufbx evaluates each stack's curves (all layers, pre/post rotations, pivots and rotation
 orders included) into local translation, rotation and scale keys per node at the file's
-frame rate, plus the curves' own key times (``bake_anim``; its key reduction off). rigedit
+frame rate, plus the curves' own key times (``bake_anim``; its key reduction off; at most
+:data:`MAX_SEGMENTS` samples between two keys). rigedit
 then drops only the keys that the interpolation of their neighbours reproduces within
 :data:`EXACT` (linear for vectors, slerp for rotations), so sampling at any baked time gives
 the baked value. Keys of a joint below folded non-joint nodes are mapped through that
@@ -19,6 +20,9 @@ from .gltf_anim import clip_names, quat_left_matrix
 
 __all__ = ["bake_stacks", "animated_nodes", "clips_of", "weight_tracks", "reduce_keys",
            "EXACT"]
+
+#: Most samples ufbx takes between two keys of a curve (an hour at 30 frames per second).
+MAX_SEGMENTS = 108_000
 
 #: A key is dropped when its neighbours' interpolation gives it within this (file units
 #: after conversion: metres, unit quaternion components, scale factors).
@@ -156,10 +160,19 @@ def bake_stacks(scene, keep, fps):
     ufbx = ufbx_module()
     stacks = scene.anim_stacks
     out = []
+    curves = scene.anim_curves
+    curve_span = (max(float(c.max_time) for c in curves) - min(float(c.min_time) for c in curves)
+                  if curves else 0.0)
     for name, stack in zip(clip_names([s.name for s in stacks]), stacks):
+        # ufbx samples a key interval at most max_keyframe_segments times (30 by default:
+        # a bezier curve keyed every 10 s would get no key at most frames), so allow every
+        # frame of the take, bounded (a file's time range is a claim)
+        frames = max(float(stack.time_end) - float(stack.time_begin), curve_span) * fps
+        segments = int(min(MAX_SEGMENTS, max(32, np.ceil(frames) + 1 if np.isfinite(frames)
+                                              else MAX_SEGMENTS)))
         bake = call(ufbx.bake_anim, scene, stack.anim, keep=keep, resample_rate=fps,
                     minimum_sample_rate=fps, key_reduction_enabled=False,
-                    trim_start_time=False)
+                    trim_start_time=False, max_keyframe_segments=segments)
         nodes = {}
         for baked in bake.nodes:
             nodes[baked.typed_id] = {

@@ -206,6 +206,25 @@ def test_blend_shape_is_a_morph_target_with_its_weight_curve(tmp_path):
         assert cKDTree(posed).query(expected)[0].max() < 1e-6
 
 
+def test_a_sparse_curve_is_baked_at_every_frame(tmp_path):
+    # a cubic DeformPercent curve keyed at 0, 10 and 20 s: ufbx's default bake takes 30
+    # samples per key interval; the file's 24 fps is asked for, so every frame is a key
+    path = tmp_path / "cubic.fbx"
+    path.write_text(mini_fbx([(0.0, 0.0), (10.0, 100.0), (20.0, 0.0)])
+                    .replace("a: 260", "a: 1032"))          # KeyAttrFlags: cubic, auto
+    clip = read_fbx(path).clips["Take 001"]
+    frames = np.round(clip.morph_tracks["Raise"].times * 24)
+    assert len(frames) > 470 and np.allclose(frames, clip.morph_tracks["Raise"].times * 24)
+    # and at every frame the clip's weight is the curve's (ufbx evaluates it)
+    import ufbx
+    from rigedit.io.fbx_read_scene import call, open_scene
+    scene, keep = open_scene(path)
+    curve = scene.anim_curves[0]
+    for k in range(0, 20 * 24 + 1, 7):
+        expected = call(ufbx.evaluate_curve, curve, k / 24, 0.0, keep=keep) / 100
+        assert abs(clip.sample_morphs(k / 24)["Raise"] - expected) < 1e-6
+
+
 def _png(path):
     import imageio.v3 as iio
     iio.imwrite(path, np.full((4, 4, 3), [10, 200, 30], np.uint8))
