@@ -3,12 +3,15 @@
 Written from the format's structure, without Autodesk's SDK: the container by
 :mod:`rigedit.io.fbx_binary`, the document by :mod:`rigedit.io.fbx_document`, the mesh and
 materials by :mod:`rigedit.io.fbx_write_mesh`, the limb nodes, skin clusters and bind pose by
-:mod:`rigedit.io.fbx_write_skin`, the clips by :mod:`rigedit.io.fbx_write_anim`.
+:mod:`rigedit.io.fbx_write_skin`, morph targets as blend shapes by
+:mod:`rigedit.io.fbx_write_morph`, the clips and weight tracks by
+:mod:`rigedit.io.fbx_write_anim`.
 
 What is written: the mesh (rest vertices, triangles, normals, UVs, one material per glTF
 material used, base colour textures embedded in the file), the skeleton as limb nodes with
 their rest transforms, the skin (one cluster per joint with the bind matrices), a bind pose,
-and each clip as an animation stack keyed at every frame of 30 fps and at its own keys. What is
+morph targets as blend shape channels, and each clip as an animation stack keyed at every
+frame of 30 fps and at its own keys (weight tracks as the channels' percent curves). What is
 not: a clip's loop flag, a bone's tail and deform flag, a material's double-sidedness and
 alpha mode, other texture maps (FBX has fields for some; rigedit keeps only the base colour).
 
@@ -28,6 +31,7 @@ from .fbx_binary import encode
 from .fbx_document import Scene
 from .fbx_write_anim import FPS, write_clips
 from .fbx_write_mesh import write_mesh
+from .fbx_write_morph import write_morphs
 from .fbx_write_skin import write_bind_pose, write_skeleton, write_skin
 
 __all__ = ["write_fbx", "fbx_bytes", "UNITS"]
@@ -68,13 +72,16 @@ def fbx_bytes(rig, clips=None, units="cm"):
     scene = Scene(up=rig.up, unit_cm=unit_cm, fps=FPS)
     chosen = _selected(rig, clips)
     joints = write_skeleton(scene, rig.skeleton, unit)
-    mesh = None
+    mesh, channels = None, {}
     if len(rig.vertices):
         mesh, geometry = write_mesh(scene, rig, unit)
         if rig.indices is not None and rig.weights is not None:
             write_skin(scene, rig, geometry, joints, unit)
+        morphs = getattr(rig, "morphs", None)
+        if morphs is not None and morphs.count:
+            channels = write_morphs(scene, morphs, geometry, rig.name, unit)
     write_bind_pose(scene, rig.name, mesh, rig.skeleton, joints, unit)
-    write_clips(scene, chosen, joints, rig.skeleton, unit)
+    write_clips(scene, chosen, joints, rig.skeleton, unit, channels)
     return encode(scene.nodes())
 
 

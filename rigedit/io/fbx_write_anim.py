@@ -6,7 +6,8 @@ A clip becomes an ``AnimationStack`` (its time span 0 to the clip's duration) wi
 ``AnimationCurve`` children (``d|X``, ``d|Y``, ``d|Z``): key times in FBX ticks
 (:data:`~rigedit.io.fbx_document.TICKS_PER_SECOND`), float values, and one interpolation flag
 for all keys (linear, or constant for a ``step`` track). Joints without a track keep their
-rest transform (the models' static ``Lcl`` values).
+rest transform (the models' static ``Lcl`` values). A morph weight track is a curve node on
+its blend shape channel's ``DeformPercent`` (the weight times 100).
 
 FBX curves are per Euler angle and interpolate each one linearly, which is not a slerp of
 quaternions (nor a spline), so a track is sampled rather than copied: at its own keys and at
@@ -65,8 +66,12 @@ def sample_times(track, duration, fps=FPS):
     """(N,) times a track is written at, seconds: its keys within ``[0, duration]``, both
     ends, and every frame when FBX's linear curve is not the track's own (rotations, splines);
     no two in the same tick."""
-    times = [track.times[(track.times >= 0) & (track.times <= duration)], [0.0, duration]]
     exact = track.channel != "rotation" and track.interpolation in ("linear", "step")
+    return _times(track.times, duration, exact, fps)
+
+
+def _times(keys, duration, exact, fps=FPS):
+    times = [keys[(keys >= 0) & (keys <= duration)], [0.0, duration]]
     if not exact:
         times.append(np.arange(int(np.floor(duration * fps + 1e-9)) + 1) / fps)
     t = np.unique(np.concatenate(times))
@@ -74,11 +79,12 @@ def sample_times(track, duration, fps=FPS):
     return t[first]
 
 
-def _curves(scene, node_id, times, values, interpolation):
-    """The three curves of a curve node: key times ``times`` (N,), values (N, 3)."""
+def _curves(scene, node_id, times, values, step, names="XYZ"):
+    """The curves of a curve node, one per name (``d|X``...): key times ``times`` (N,),
+    values (N, len(names)), constant interpolation when ``step``, else linear."""
     key_time = np.array([ticks(t) for t in times], dtype=np.int64)
-    flag = _CONSTANT if interpolation == "step" else _LINEAR
-    for axis, name in enumerate("XYZ"):
+    flag = _CONSTANT if step else _LINEAR
+    for axis, name in enumerate(names):
         uid, curve = scene.add("AnimationCurve", "", "AnimCurve")
         column = np.asarray(values[:, axis], dtype=np.float32)
         curve.add("Default", float(column[0]))
@@ -104,10 +110,21 @@ def _track(scene, layer, model, track, duration, unit):
                                for k, a in enumerate("XYZ"))))
     scene.connect(uid, layer)
     scene.connect(uid, model, prop)
-    _curves(scene, uid, times, values, track.interpolation)
+    _curves(scene, uid, times, values, track.interpolation == "step")
 
 
-def write_clips(scene, clips, joint_ids, skeleton, unit):
+def _weight_track(scene, layer, channel, track, duration):
+    """A morph weight track as its channel's ``DeformPercent`` curve (weight x 100)."""
+    times = _times(track.times, duration, exact=track.interpolation in ("LINEAR", "STEP"))
+    values = np.array([[track.sample(t) * 100.0] for t in times])
+    uid, node = scene.add("AnimationCurveNode", "DeformPercent", "AnimCurveNode")
+    node.append(properties70(("d|DeformPercent", "number", float(values[0, 0]))))
+    scene.connect(uid, layer)
+    scene.connect(uid, channel, "DeformPercent")
+    _curves(scene, uid, times, values, track.interpolation == "STEP", names=("DeformPercent",))
+
+
+def write_clips(scene, clips, joint_ids, skeleton, unit, channels=None):
     """An animation stack per clip.
 
     Parameters
@@ -119,7 +136,11 @@ def write_clips(scene, clips, joint_ids, skeleton, unit):
     skeleton : rigedit.model.skeleton.Skeleton
     unit : float
         File units per metre.
+    channels : dict[str, Int64], optional
+        Morph target name -> blend shape channel id; a clip's weight tracks of targets not
+        in it (a clip made for another mesh) are not written.
     """
+    channels = channels or {}
     for clip in clips:
         duration = float(clip.duration)
         stack, node = scene.add("AnimationStack", clip.name, "AnimStack")
@@ -132,3 +153,6 @@ def write_clips(scene, clips, joint_ids, skeleton, unit):
         scene.takes.append((clip.name, duration))
         for (joint, _channel), track in clip.tracks.items():
             _track(scene, layer, joint_ids[skeleton.index[joint]], track, duration, unit)
+        for target, track in getattr(clip, "morph_tracks", {}).items():
+            if target in channels:
+                _weight_track(scene, layer, channels[target], track, duration)

@@ -12,6 +12,7 @@ from scipy.spatial.transform import Rotation
 
 import rigedit
 from rigedit.animation.clip import Clip, Track
+from rigedit.animation.morph_track import WeightTrack
 from rigedit.cli.main import main
 from rigedit.errors import RigFileError
 from rigedit.io.data import RigData
@@ -19,8 +20,10 @@ from rigedit.io.fbx_binary import Int64, Node, encode
 from rigedit.io.fbx_write import write_fbx
 from rigedit.io.fbx_write_anim import continuous_euler, sample_times
 from rigedit.model.kinematics import local_to_model
+from rigedit.model.morph import MorphTargets
 from rigedit.model.skeleton import Skeleton
-from builders import chain_skeleton
+from rigedit.rig import Rig
+from builders import chain_skeleton, cylinder_rig
 from testpaths import DATA, TESTS
 
 CESIUM = DATA / "khronos-gltf" / "CesiumMan.glb"
@@ -262,3 +265,38 @@ def test_skeleton_without_mesh_z_up_and_scaled_joints(tmp_path):
         ref = local_to_model(sk, clip.sample(t))[:, :3, 3]
         np.testing.assert_allclose(got[f"bones_0_{k}"][order], ref, atol=1e-6)
     assert got["up_axis"] == 4      # ufbx.CoordinateAxis.POSITIVE_Z: the data stays as it is
+
+
+def test_morph_targets_as_blend_shapes(tmp_path):
+    """Two morph targets with weight tracks (linear and step) under a bending joint: ufbx's
+    blend shapes and skinning give rigedit's morphed, skinned vertices."""
+    base = cylinder_rig()
+    v = base.vertices
+    bulge = np.zeros_like(v)
+    top = v[:, 1] > 2.0
+    bulge[top, 0] = 0.2 * v[top, 0]
+    bulge[top, 2] = 0.2 * v[top, 2]
+    lean = np.zeros_like(v)
+    lean[:, 0] = 0.05 * v[:, 1]
+    morphs = MorphTargets(("bulge", "lean"), np.stack([bulge, lean]),
+                          default_weights=np.array([0.0, 0.25]))
+    data = base.data()
+    data.morphs = morphs
+    clip = base.clips["bend"]
+    clip.morph_tracks = {}
+    clip.set_morph_track("bulge", WeightTrack([0, 0.5, 1], [0, 1, 0.3]))
+    clip.set_morph_track("lean", WeightTrack([0, 0.4], [0.25, 1.0], "STEP"))
+    data.clips = {"bend": clip}
+    rig = Rig.from_data(data)
+    path = tmp_path / "morph.fbx"
+    write_fbx(data, path)
+    times = [0.0, 0.2, 0.39, 0.45, 0.5, 0.8, 1.0]
+    got = probe(path, {"bend": times}, tmp_path)
+    diag = np.linalg.norm(np.ptp(v, axis=0))
+    for k, t in enumerate(times):
+        ref = rig.skin(clip.sample(t), morph_weights=clip.sample_morphs(t))
+        err = np.abs(got[f"skinned_0_{k}"] - ref).max() / diag
+        assert err < TOLERANCE, (t, err)
+    # the weights mattered: without them the mesh is elsewhere
+    plain = rig.skin(clip.sample(0.5), morph_weights=[0, 0])
+    assert np.abs(got["skinned_0_4"] - plain).max() / diag > 1e-2
