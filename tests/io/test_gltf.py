@@ -269,16 +269,28 @@ def _paths(node, prefix=()):
             yield from _paths(v, prefix + (i,))
 
 
-def test_every_field_with_a_wrong_value_gives_rig_file_error_or_loads(tmp_path):
-    """Fuzz: each field of a small skinned file replaced by a value of another kind or out of
-    range; loading either works or raises one RigFileError naming the file, nothing else."""
+@pytest.mark.parametrize("kind", ["two_bone", "morphs", "skins"])
+def test_every_field_with_a_wrong_value_gives_rig_file_error_or_loads(tmp_path, kind):
+    """Fuzz: each field of a small skinned file (the bar; the bar with morph targets and a
+    weights channel; three skins with rigid parts) replaced by a value of another kind or
+    out of range; loading either works or raises one RigFileError naming the file, nothing
+    else."""
     import copy
 
-    builder, _ = two_bone(interpolation="CUBICSPLINE", sparse=True)
+    from gltf_builder import morph_bar, two_skins_and_parts
+
+    builder, _ = {"two_bone": lambda: two_bone(interpolation="CUBICSPLINE", sparse=True),
+                  "morphs": lambda: morph_bar("CUBICSPLINE"),
+                  "skins": two_skins_and_parts}[kind]()
+    # the bar's run covers the accessors and buffer views; the others what they add
+    focus = {"two_bone": None, "morphs": ("meshes", "animations"),
+             "skins": ("nodes", "skins", "scenes")}[kind]
     base = builder.doc
     bad_values = ["x", -1, 2 ** 31, None, [], {}, 1.5, [float("nan")] * 3]
     outcomes = {"loaded": 0, "refused": 0}
     for path, _ in list(_paths(base))[1:]:
+        if focus is not None and path[0] not in focus:
+            continue
         for bad in bad_values:
             doc = copy.deepcopy(base)
             target = doc
