@@ -56,6 +56,11 @@ __all__ = ["read_bvh", "load_bvh", "save_bvh", "parse_bvh", "guess_unit", "belie
            "TYPICAL_HEIGHT", "CLIP_NAME"]
 
 CLIP_NAME = "take"
+#: Bound on a figure's lengths in metres (offsets, End Sites, position channels, times the
+#: scale): a thousand kilometres. Written back as BVH in millimetres it stays within the
+#: reader's bound on file values (:data:`rigedit.io.bvh_parse.MAX_VALUE`), so whatever is
+#: read can be exported and read again, and float32 skinning is far from overflow.
+MAX_METRES = 1e6
 #: Frames looked at, evenly spaced, to find carrier roots and to measure the figure.
 SAMPLED_FRAMES = 32
 
@@ -181,6 +186,17 @@ def _units(path, size, measured, scale):
     return scale, unit, True, note
 
 
+def _check_metres(path, data, translations, scale):
+    """Refuse lengths beyond :data:`MAX_METRES` once scaled (see there)."""
+    ends = [e for e in data["ends"] if e is not None]
+    parts = [data["offsets"], *ends, *translations.values()]
+    largest = max(float(np.abs(p).max()) if np.size(p) else 0.0 for p in parts) * scale
+    if largest > MAX_METRES:
+        raise RigFileError(path, f"expected lengths within {MAX_METRES:g} m, got "
+                                 f"{largest:.3g} m (at {scale:g} m per unit): a figure that "
+                                 "large cannot be skinned or exported")
+
+
 def _clip(data, skeleton, rotations, translations, scale):
     """``{"take": Clip}`` of the file's frames (one key per frame), {} without frames."""
     if not len(data["frames"]):
@@ -226,6 +242,7 @@ def read_bvh(path, scale=None):
     measured = f"{size:.4g} units across" + (f", carrier root {left_out} left out"
                                              if left_out else "")
     scale, unit, guessed, units_note = _units(path, size, measured, scale)
+    _check_metres(path, data, translations, scale)
     rest = Skeleton(names, parents, offsets).bind_matrices[:, :3, 3]
     tails = np.full_like(rest, np.nan)
     for j, end in enumerate(ends):

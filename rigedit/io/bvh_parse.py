@@ -1,6 +1,12 @@
-"""BVH text -> plain arrays: the HIERARCHY by recursive descent (with line numbers for
-errors), the MOTION block in one pass of numpy's C reader. No units, no rig: see
-:mod:`rigedit.io.bvh` for what the numbers mean.
+"""BVH text -> plain arrays: the HIERARCHY by a descent with its own stack (a file nested
+10,000 joints deep is read, not a RecursionError; line numbers for errors), the MOTION block
+in one pass of numpy's C reader. No units, no rig: see :mod:`rigedit.io.bvh` for what the
+numbers mean.
+
+Counts (``CHANNELS n``, ``Frames: n``) are ASCII digits only (``int()`` would take ``'³'`` or
+``'３'`` and fail later), and every number is within :data:`MAX_VALUE` in magnitude: a figure
+larger than that (a million kilometres in millimetres) overflows float32 skinning once
+squared or multiplied through a chain, and its export would not load back.
 """
 from __future__ import annotations
 
@@ -11,7 +17,14 @@ import numpy as np
 
 from ..errors import RigFileError
 
-__all__ = ["parse_bvh", "CHANNEL_AXES"]
+__all__ = ["parse_bvh", "CHANNEL_AXES", "MAX_VALUE", "MAX_DEPTH"]
+
+#: Bound on every OFFSET and channel value (file units or degrees).
+MAX_VALUE = 1e9
+#: Joints nested deeper than this are refused (no figure has a chain of a thousand bones;
+#: the skeleton's own walks stay fast below it).
+MAX_DEPTH = 1000
+_COUNT = re.compile(r"[0-9]{1,9}")  # ASCII digits only
 
 #: Channel names (lower case) -> (kind, axis index).
 CHANNEL_AXES = {f"{a}{kind}": (kind, i) for i, a in enumerate("xyz")
@@ -70,6 +83,9 @@ class _Tokens:
         arr = np.array(out)
         if not np.all(np.isfinite(arr)):
             raise self.error(f"expected finite numbers after {what}, got {tok!r}", line)
+        if np.any(np.abs(arr) > MAX_VALUE):
+            raise self.error(f"expected numbers within +-{MAX_VALUE:g} after {what}, got "
+                             f"{arr[np.abs(arr) > MAX_VALUE][0]:g}", line)
         return arr
 
     def name_until_brace(self, what):
@@ -81,27 +97,41 @@ class _Tokens:
         return " ".join(words)
 
 
-def _parse_joint(tok, joints, parent, line):
+def _open_joint(tok, joints, parent, line, stack):
+    if len(stack) >= MAX_DEPTH:
+        raise tok.error(f"expected joints nested at most {MAX_DEPTH} deep, got deeper", line)
     joint = _Joint(tok.name_until_brace("joint name"), parent, line)
     joints.append(joint)
     tok.expect("{")
-    while True:
+    stack.append(joint)
+
+
+def _channels(tok, joint):
+    count_tok, cline = tok.next("a channel count")
+    if not _COUNT.fullmatch(count_tok):
+        raise tok.error(f"expected a channel count (digits 0-9), got {count_tok!r}", cline)
+    for _ in range(int(count_tok)):
+        name, nline = tok.next(f"{count_tok} channel names")
+        if name.lower() not in CHANNEL_AXES:
+            raise tok.error(f"expected a channel name (Xposition ... Zrotation), "
+                            f"got {name!r}", nline)
+        joint.channels.append(CHANNEL_AXES[name.lower()])
+
+
+def _parse_joint(tok, joints, parent, line):
+    """A ROOT block and every joint below it, with an explicit stack of open joints."""
+    stack = []
+    _open_joint(tok, joints, parent, line, stack)
+    while stack:
+        joint = stack[-1]
         word, wline = tok.next("OFFSET, CHANNELS, JOINT, End Site or '}'")
         key = word.upper()
         if key == "OFFSET":
             joint.offset = tok.floats(3, "OFFSET")
         elif key == "CHANNELS":
-            count_tok, cline = tok.next("a channel count")
-            if not count_tok.isdigit():
-                raise tok.error(f"expected a channel count, got {count_tok!r}", cline)
-            for _ in range(int(count_tok)):
-                name, nline = tok.next(f"{count_tok} channel names")
-                if name.lower() not in CHANNEL_AXES:
-                    raise tok.error(f"expected a channel name (Xposition ... Zrotation), "
-                                    f"got {name!r}", nline)
-                joint.channels.append(CHANNEL_AXES[name.lower()])
+            _channels(tok, joint)
         elif key == "JOINT":
-            _parse_joint(tok, joints, joint, wline)
+            _open_joint(tok, joints, joint, wline, stack)
         elif key == "END":
             tok.expect("Site")
             tok.expect("{")
@@ -109,12 +139,13 @@ def _parse_joint(tok, joints, parent, line):
             joint.end = tok.floats(3, "OFFSET")
             tok.expect("}")
         elif word == "}":
-            break
+            if joint.offset is None:
+                raise tok.error(f"expected an OFFSET in joint {joint.name!r}, got none",
+                                joint.line)
+            stack.pop()
         else:
             raise tok.error(f"expected OFFSET, CHANNELS, JOINT, End Site or '}}' in joint "
                             f"{joint.name!r}, got {word!r}", wline)
-    if joint.offset is None:
-        raise tok.error(f"expected an OFFSET in joint {joint.name!r}, got none", line)
 
 
 def _parse_hierarchy(path, lines):
@@ -131,16 +162,21 @@ def _parse_hierarchy(path, lines):
     return joints
 
 
-def _header_value(path, lines, i, label):
+def _header_value(path, lines, i, label, integer=False):
     if i >= len(lines) or not lines[i].strip().lower().startswith(label.lower()):
         got = repr(lines[i].strip()[:40]) if i < len(lines) else "the end of the file"
         raise RigFileError(path, f"line {i + 1}: expected '{label}', got {got}")
     text = lines[i].strip()[len(label):].strip()
+    if integer:
+        if not _COUNT.fullmatch(text):
+            raise RigFileError(path, f"line {i + 1}: expected a number after '{label}' (a frame "
+                                     f"count in digits 0-9), got {text[:40]!r}")
+        return int(text)
     try:
         return float(text)
     except ValueError:
         raise RigFileError(path, f"line {i + 1}: expected a number after '{label}', "
-                                 f"got {text!r}") from None
+                                 f"got {text[:40]!r}") from None
 
 
 def _frame_rows(lines, first):
@@ -172,21 +208,20 @@ def _diagnose_frames(path, lines, first, frames, num_channels):
 def _parse_motion(path, lines, start, num_channels):
     """(N, C) frame values and the frame time, from the lines after ``MOTION``."""
     i = start
-    frames = _header_value(path, lines, i, "Frames:")
-    if frames != int(frames) or frames < 0:
-        raise RigFileError(path, f"line {i + 1}: expected a frame count >= 0, got {frames:g}")
-    frames = int(frames)
+    frames = _header_value(path, lines, i, "Frames:", integer=True)
     frame_time = _header_value(path, lines, i + 1, "Frame Time:")
-    if not frame_time > 0 or not np.isfinite(frame_time):
-        raise RigFileError(path, f"line {i + 2}: expected a Frame Time > 0 seconds, got "
-                                 f"{frame_time:g}")
+    if not frame_time > 0 or not np.isfinite(frame_time) or frame_time > 3600:
+        raise RigFileError(path, f"line {i + 2}: expected a Frame Time > 0 seconds (at most "
+                                 f"an hour), got {frame_time:g}")
     first = i + 2
     if frames == 0 or num_channels == 0:
         _, numbers = _frame_rows(lines, first)
         if numbers and num_channels:
             raise RigFileError(path, f"line {numbers[0]}: expected no frame lines (Frames: 0), "
                                      f"got some")
-        return np.zeros((frames, 0)), frame_time
+        # Frames: 0 is a skeleton without motion (read_bvh gives no clip); without channels
+        # the frames hold nothing either
+        return np.zeros((0, num_channels)), frame_time
     # numpy's C reader: one pass over the block (blank lines skipped); errors are then
     # located line by line on the slow path
     try:
@@ -199,6 +234,11 @@ def _parse_motion(path, lines, start, num_channels):
     if bad.any():
         line = _frame_rows(lines, first)[1][int(np.flatnonzero(bad)[0])]
         raise RigFileError(path, f"line {line}: expected finite numbers, got NaN or inf")
+    big = np.any(np.abs(data) > MAX_VALUE, axis=1)
+    if big.any():
+        line = _frame_rows(lines, first)[1][int(np.flatnonzero(big)[0])]
+        raise RigFileError(path, f"line {line}: expected channel values within "
+                                 f"+-{MAX_VALUE:g}, got {np.abs(data[big]).max():g}")
     return data, frame_time
 
 

@@ -248,8 +248,7 @@ def _hierarchy(names, parents, orders, with_pos, offsets, ends, translations, eu
     order_dfs, children = _depth_first(parents)
     lines, columns = ["HIERARCHY"], []
 
-    def write(j, depth):
-        pad = "  " * depth
+    def open_joint(j, pad):
         kind = "ROOT" if parents[j] < 0 else "JOINT"
         o = offsets[j]
         chans = (("Xposition Yposition Zposition " if with_pos[j] else "")
@@ -260,18 +259,24 @@ def _hierarchy(names, parents, orders, with_pos, offsets, ends, translations, eu
         if with_pos[j]:
             columns.append(translations[:, j])
         columns.append(euler[:, j])
-        for c in children[j]:
-            write(c, depth + 1)
         if not children[j]:
             end = ends[j]
             lines.extend([f"{pad}  End Site", f"{pad}  {{",
                           f"{pad}    OFFSET {end[0]:.6f} {end[1]:.6f} {end[2]:.6f}",
                           f"{pad}  }}"])
-        lines.append(f"{pad}}}")
 
-    for j in order_dfs:
-        if parents[j] < 0:
-            write(j, 0)
+    # an explicit stack, not recursion: a chain of thousands of joints (from a glTF or a
+    # rig folder) is written like any other
+    stack = [(j, 0, False) for j in reversed(order_dfs) if parents[j] < 0]
+    while stack:
+        j, depth, done = stack.pop()
+        pad = "  " * depth
+        if done:
+            lines.append(f"{pad}}}")
+            continue
+        open_joint(j, pad)
+        stack.append((j, depth, True))
+        stack.extend((c, depth + 1, False) for c in reversed(children[j]))
     return lines, columns
 
 

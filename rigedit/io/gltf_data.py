@@ -20,6 +20,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RigFileError
+from .gltf_checks import check_document
+from .jsonfile import MAX_MAGNITUDE
+from .paths import read_bytes
 
 __all__ = ["GltfData", "COMPONENT_DTYPES", "TYPE_WIDTHS", "SUPPORTED_EXTENSIONS"]
 
@@ -34,6 +37,13 @@ TYPE_WIDTHS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 
 _NORM = {5120: 127.0, 5121: 255.0, 5122: 32767.0, 5123: 65535.0}
 #: Extensions that change how geometry must be read and that rigedit implements.
 SUPPORTED_EXTENSIONS = ("KHR_mesh_quantization",)
+#: Bound on the elements (count x components) of the accessors that no bytes back (zero
+#: filled, per the spec, when there is no bufferView): their count is only a claim. Such an
+#: accessor mirrors data the file holds (a morph target's or sparse accessor's base), so at
+#: most 4 elements per byte of the file and its buffers (a float VEC3 is 0.25 per byte), and
+#: never more than 2**26 in all (512 MiB as float64).
+CLAIM_ELEMENTS_PER_BYTE = 4
+MAX_CLAIMED_ELEMENTS = 2**26
 
 
 _HINTS = {}
@@ -105,6 +115,10 @@ class GltfData:
     ----------
     path : str or Path
         A ``.glb`` or ``.gltf`` file (the container is recognised by its magic, not its name).
+    allow_outside_uris : bool
+        Read buffer and image URIs that leave the file's folder (absolute paths, ``..``,
+        ``file:``). Off by default: a shared glTF could otherwise copy any file of the
+        machine into the rig (and from there into an exported ``.glb``).
 
     Attributes
     ----------
@@ -112,12 +126,12 @@ class GltfData:
     path : Path
     """
 
-    def __init__(self, path):
+    def __init__(self, path, allow_outside_uris=False):
         self.path = Path(path)
-        try:
-            raw = self.path.read_bytes()
-        except OSError as exc:
-            raise RigFileError(self.path, f"cannot read the file ({exc.strerror or exc})") from None
+        self.allow_outside_uris = bool(allow_outside_uris)
+        raw = read_bytes(self.path)  # a regular file of bounded size, FIFOs never opened
+        self._size = len(raw)
+        self._claimed = {}
         self._bin = None
         if raw[:4] == GLB_MAGIC:
             text = self._split_glb(raw)
@@ -131,8 +145,12 @@ class GltfData:
             doc = json.loads(text)
         except (UnicodeDecodeError, ValueError) as exc:
             raise RigFileError(self.path, f"expected glTF JSON, got invalid JSON ({exc})") from None
+        except RecursionError:
+            raise RigFileError(self.path, "expected glTF JSON nested a few levels deep, got "
+                                          "deeper nesting than the parser allows") from None
         if not isinstance(doc, dict) or not isinstance(doc.get("asset"), dict):
             raise RigFileError(self.path, "expected a glTF JSON object with an 'asset', got none")
+        check_document(self.path, doc)
         version = str(doc["asset"].get("version", ""))
         if not version.startswith("2."):
             raise RigFileError(self.path, f"expected glTF version 2.x, got {version!r}")
@@ -224,12 +242,41 @@ class GltfData:
                 return urllib.parse.unquote_to_bytes(payload)
             except ValueError as exc:
                 raise RigFileError(self.path, f"{where}: bad base64 data ({exc})") from None
-        target = self.path.parent / urllib.parse.unquote(uri)
+        target = self._uri_path(uri, where)
         try:
-            return target.read_bytes()
-        except OSError as exc:
-            raise RigFileError(self.path, f"{where}: cannot read {target} "
-                                          f"({exc.strerror or exc})") from None
+            return read_bytes(target)
+        except RigFileError as exc:  # named from the glTF file, which the user opened
+            raise RigFileError(self.path, f"{where}: cannot read {target} ({exc.problem})") \
+                from None
+
+    def _uri_path(self, uri, where):
+        """The file a (non-data) URI names, refused when it leaves the glTF's folder (an
+        absolute path, ``..`` climbing out, a ``file:`` URI, a symbolic link pointing out)
+        unless ``allow_outside_uris``; other schemes (``http:``) are never fetched."""
+        scheme = urllib.parse.urlsplit(uri).scheme
+        if scheme == "file":
+            if not self.allow_outside_uris:
+                raise RigFileError(self.path, f"{where}: expected a uri relative to the file's "
+                                              f"folder, got {uri[:80]!r} (a file: uri; allow "
+                                              "it with --allow-outside-uris)")
+            return Path(urllib.parse.unquote(urllib.parse.urlsplit(uri).path))
+        if len(scheme) > 1:  # one letter is a Windows drive (C:/...), an absolute path
+            raise RigFileError(self.path, f"{where}: expected a file or data uri, got a "
+                                          f"{scheme}: uri (rigedit fetches nothing)")
+        relative = urllib.parse.unquote(uri)
+        target = self.path.parent / relative
+        if self.allow_outside_uris:
+            return target
+        folder = self.path.parent.resolve()
+        try:
+            inside = target.resolve().is_relative_to(folder)
+        except (OSError, RuntimeError, ValueError):  # a symlink loop, a NUL byte
+            inside = False
+        if Path(relative).is_absolute() or len(scheme) == 1 or not inside:
+            raise RigFileError(self.path, f"{where}: expected a uri inside the file's folder, "
+                                          f"got {uri[:80]!r} (allow it with "
+                                          "--allow-outside-uris)")
+        return target
 
     def view_bytes(self, index, where):
         """(bytes, stride or None) of buffer view ``index``, bounds checked."""
@@ -292,6 +339,7 @@ class GltfData:
                                           f"got {acc.componentType!r} {acc.type!r}")
         count = _int(acc.count, f"{where} count", self.path, 1)
         if acc.bufferView is None:
+            self._claim(index, count * width, where)
             out = np.zeros((count, width), dtype=dtype)
         else:
             view, stride = self.view_bytes(acc.bufferView, where)
@@ -301,13 +349,39 @@ class GltfData:
         if acc.sparse is not None:
             self._apply_sparse(acc, out, dtype, width, where)
         if dtype.kind == "f":
-            return out.astype(np.float64)
+            out = out.astype(np.float64)
+            self._check_values(out, where)
+            return out
         if acc.normalized:
             if acc.componentType not in _NORM:
                 raise RigFileError(self.path, f"{where}: expected a normalised byte or short, "
                                               f"got componentType {acc.componentType}")
             return np.maximum(out / _NORM[acc.componentType], -1.0)
         return out
+
+    def _check_values(self, values, where):
+        """Refuse NaN, inf and magnitudes beyond :data:`~rigedit.io.jsonfile.MAX_MAGNITUDE`
+        (10^9): such numbers overflow float32 skinning once multiplied through a joint chain,
+        and a rig folder or BVH written from them would not load back."""
+        bad = ~(np.abs(values) <= MAX_MAGNITUDE)   # NaN compares false
+        if bad.any():
+            value = values[bad][0]
+            raise RigFileError(self.path, f"{where}: expected finite values within "
+                                          f"+-{MAX_MAGNITUDE:g}, got {value:g}")
+
+    def _claim(self, index, elements, where):
+        """Allow a zero-filled accessor of ``elements`` only within the file's bound."""
+        self._claimed[index] = elements
+        total = sum(self._claimed.values())
+        # the buffers' declared lengths (checked against their bytes when they are read):
+        # the bound holds before any external buffer is loaded
+        data = self._size + sum(b.byteLength for b in self.gltf.buffers or []
+                                if _is_int(b.byteLength) and b.byteLength > 0)
+        bound = min(MAX_CLAIMED_ELEMENTS, max(2**16, CLAIM_ELEMENTS_PER_BYTE * data))
+        if total > bound:
+            raise RigFileError(self.path, f"{where}: expected accessors without a bufferView "
+                                          f"of at most {bound} elements in all (what a file of "
+                                          f"{data} bytes can justify), got {total}")
 
     def _apply_sparse(self, acc, out, dtype, width, where):
         sparse = acc.sparse
