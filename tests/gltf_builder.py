@@ -394,3 +394,27 @@ def morph_bar(interpolation="LINEAR", names=("smile", "frown")):
     anim["channels"].append({"sampler": len(anim["samplers"]) - 1,
                              "target": {"node": mesh_node, "path": "weights"}})
     return b, dict(expected, deltas=np.stack([d0, d1]), normal_deltas=np.stack([np.zeros((8, 3)), n1]))
+
+
+def deep_chain(n, rigid_chain=False):
+    """A skin of ``n`` joints in one chain (each the child of the last) and one skinned bar;
+    with ``rigid_chain`` also a chain of ``n`` non-joint nodes each holding a rigid mesh."""
+    b = GltfBuilder()
+    nodes = b.doc["nodes"]
+    for i in range(n):
+        nodes.append({"name": f"j{i}", "translation": [0.0, 0.001, 0.0],
+                      **({"children": [i + 1]} if i < n - 1 else {})})
+    b.doc["meshes"] += [{"primitives": [_bar_primitive(b, (0, 0, 0), [0], rows=2)]},
+                        {"primitives": [_bar_primitive(b, (0, 0, 0), [0], rows=2,
+                                                       skinned=False)]}]
+    ibm = np.tile(np.eye(4), (n, 1, 1)).reshape(n, 16)
+    b.doc["skins"].append({"joints": list(range(n)), "inverseBindMatrices": b.accessor(ibm)})
+    nodes.append({"mesh": 0, "skin": 0})
+    b.doc["scenes"][0]["nodes"] = [0, n]
+    if rigid_chain:
+        base = len(nodes)
+        for i in range(n):
+            nodes.append({"mesh": 1, "translation": [0.001, 0.0, 0.0],
+                          **({"children": [base + i + 1]} if i < n - 1 else {})})
+        b.doc["scenes"][0]["nodes"].append(base)
+    return b

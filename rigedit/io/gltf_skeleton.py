@@ -92,10 +92,11 @@ def _members(joints, parent, mat):
         The product of the folded non-joint ancestors between a member and its parent.
     """
     members = list(joints)
-    inside = set(joints)
+    inside, walked = set(joints), set()
     for n in joints:  # non-joint ancestors that cannot be folded become joints themselves
         k = parent[n]
-        while k >= 0:
+        while k >= 0 and k not in walked:   # above a walked node all is decided
+            walked.add(k)
             if k not in inside and similarity(mat(k)) is None:
                 inside.add(k)
                 members.append(k)
@@ -119,22 +120,26 @@ def _rest_trs(data, ordered, prefix, mat, name_of):
     the file's own TRS where a node has one and nothing was folded into it, else decomposed
     from the (prefixed) matrix, a sheared one refused."""
     nodes = data.gltf.nodes
-    t, r, s = [], [], []
-    for n in ordered:
-        m = mat(n) if prefix[n] is None else prefix[n] @ mat(n)
-        tt, rr, ss = decompose_trs(m[None])
-        if not np.allclose(compose_trs(tt, rr, ss)[0], m, atol=1e-6 * max(1.0, np.abs(m).max())):
-            raise RigFileError(data.path, f"node {n} ({name_of[n]!r}): expected a transform "
-                                          "without shear, got a sheared matrix")
-        t.append(tt[0]), r.append(rr[0]), s.append(ss[0])
+    m = np.array([mat(n) if prefix[n] is None else prefix[n] @ mat(n) for n in ordered])
+    t, r, s = decompose_trs(m)   # all at once: one joint at a time took 0.45 ms each
+    back = compose_trs(t, r, s)
+    tol = 1e-6 * np.maximum(1.0, np.abs(m).max(axis=(1, 2)))
+    bad = np.flatnonzero(np.any(np.abs(back - m) > tol[:, None, None] + 1e-5 * np.abs(m),
+                                axis=(1, 2)))   # np.allclose's rule, per joint
+    if len(bad):
+        n = ordered[bad[0]]
+        raise RigFileError(data.path, f"node {n} ({name_of[n]!r}): expected a transform "
+                                      "without shear, got a sheared matrix")
+    t, r, s = list(t), list(r), list(s)
+    for i, n in enumerate(ordered):
         if nodes[n].matrix is None and prefix[n] is None:  # keep the file's own TRS exactly
             node = nodes[n]
-            t[-1] = np.asarray(node.translation if node.translation is not None else [0, 0, 0],
-                               dtype=np.float64)
+            t[i] = np.asarray(node.translation if node.translation is not None else [0, 0, 0],
+                              dtype=np.float64)
             if node.rotation is not None:
-                r[-1] = np.asarray(node.rotation, dtype=np.float64)
-            s[-1] = np.asarray(node.scale if node.scale is not None else [1, 1, 1],
-                               dtype=np.float64)
+                r[i] = np.asarray(node.rotation, dtype=np.float64)
+            s[i] = np.asarray(node.scale if node.scale is not None else [1, 1, 1],
+                              dtype=np.float64)
     return t, r, s
 
 
