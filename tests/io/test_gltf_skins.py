@@ -193,6 +193,9 @@ def test_rigid_parts_and_skins_export_back_the_same_way(tmp_path, trees):
     clip_a, clip_b = first.clips["move"], again.clips["move"]
     for t in (0.0, 0.3, 0.5, 1.0):
         assert np.abs(first.skin(clip_a.sample(t)) - again.skin(clip_b.sample(t))).max() < 1e-6
+    # the export itself, read by the spec's formulas, draws the same figure
+    assert worst(out, again) < 1e-6
+    assert np.abs(drawn(Reference(out), 0, 0.5) - drawn(Reference(path), 0, 0.5)).max() < 1e-6
     _validate(out)
 
 
