@@ -201,6 +201,37 @@ def _close(a, b):
     return np.allclose(a, b, rtol=0, atol=1e-6 * max(1.0, np.abs(a).max(), np.abs(b).max()))
 
 
+def _share_binds(data, smap, skins, inverse):
+    """Put each skin's inverse binds into ``inverse`` (a list of (4, 4), one per skeleton
+    joint, extended here by one per helper joint); fill ``smap.skin_to_joint`` and
+    ``smap.skin_offset``. Returns the helpers as (parent joint, skin) pairs."""
+    assigned, helpers = {}, []
+    for s in skins:
+        nodes = skin_joints(data, s)
+        ibm = _inverse_binds(data, s, len(nodes))
+        idx = [smap.of_node[n] for n in nodes]
+        shared = [k for k, j in enumerate(idx) if j in assigned]
+        offset = np.eye(4)
+        if shared:
+            offset = np.linalg.inv(assigned[idx[shared[0]]]) @ ibm[shared[0]]
+            if _close(offset, np.eye(4)):   # float32 noise: keep this skin's binds as given
+                offset = np.eye(4)
+        undo = np.linalg.inv(offset)
+        jmap = []
+        for k, j in enumerate(idx):
+            want = ibm[k] @ undo   # the bind that serves the pre-transformed vertices
+            if j not in assigned:
+                assigned[j] = inverse[j] = want
+            elif not _close(assigned[j], want):
+                helpers.append((j, s))
+                inverse.append(want)
+                j = len(inverse) - 1
+            jmap.append(j)
+        smap.skin_to_joint[s] = np.array(jmap, dtype=np.int64)
+        smap.skin_offset[s] = None if np.array_equal(offset, np.eye(4)) else offset
+    return helpers
+
+
 def bind_skins(data, skeleton, smap, skins):
     """Give ``skeleton`` the inverse binds of ``skins`` (see the module docstring).
 
@@ -223,28 +254,7 @@ def bind_skins(data, skeleton, smap, skins):
         The number of helper joints added.
     """
     inverse = list(np.linalg.inv(skeleton.bind_matrices))
-    assigned, helpers = {}, []   # helpers: (parent joint, skin)
-    for s in skins:
-        nodes = skin_joints(data, s)
-        ibm = _inverse_binds(data, s, len(nodes))
-        idx = [smap.of_node[n] for n in nodes]
-        shared = [k for k, j in enumerate(idx) if j in assigned]
-        offset = np.eye(4)
-        if shared:
-            offset = np.linalg.inv(assigned[idx[shared[0]]]) @ ibm[shared[0]]
-        undo = np.linalg.inv(offset)
-        jmap = []
-        for k, j in enumerate(idx):
-            want = ibm[k] @ undo   # the bind that serves the pre-transformed vertices
-            if j not in assigned:
-                assigned[j] = inverse[j] = want
-            elif not _close(assigned[j], want):
-                helpers.append((j, s))
-                inverse.append(want)
-                j = len(inverse) - 1
-            jmap.append(j)
-        smap.skin_to_joint[s] = np.array(jmap, dtype=np.int64)
-        smap.skin_offset[s] = None if _close(offset, np.eye(4)) else offset
+    helpers = _share_binds(data, smap, skins, inverse)
     sk = skeleton
     names, parents = list(sk.names), list(sk.parents)
     for j, s in helpers:
