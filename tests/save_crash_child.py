@@ -38,17 +38,18 @@ from builders import cylinder  # noqa: E402
 OPERATIONS = ("open", "replace", "rename", "unlink", "rmdir", "mkdir", "fsync")
 
 
-def rig_state(which):
+def rig_state(which, rings=9, segments=8):
     """Rig state ``"A"`` or ``"B"``: same topology, but different vertices, bone lengths,
     weights and clip sets (A: bend, wave; B: bend with other keys, twist), so any mix of the
-    two states' files differs from both."""
+    two states' files differs from both. ``rings`` x ``segments``: the cylinder's size."""
     b = which == "B"
     t = np.zeros((3, 3))
     t[1:, 1] = 1.2 if b else 1.0
     tails = np.full((3, 3), np.nan)
     tails[-1] = [0.0, 3.6 if b else 3.0, 0.0]
     sk = Skeleton(["j0", "j1", "j2"], [-1, 0, 1], t, tails=tails)
-    v, f = cylinder(radius=0.35 if b else 0.3, height=3.6 if b else 3.0, rings=9, segments=8)
+    v, f = cylinder(radius=0.35 if b else 0.3, height=3.6 if b else 3.0, rings=rings,
+                    segments=segments)
     rig = Rig(sk, v, f, name="state " + which)
     if b:   # weights that no rest pose would give: the influences squared and renormalised
         w = rig.binding.weights.astype(float) ** 2

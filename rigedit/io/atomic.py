@@ -2,7 +2,9 @@
 
 Errors name the user's file, never the hidden temporary one, and a missing folder is an error
 (:func:`check_output_folder`), not created on the fly: a typo in an output path should not
-leave new folders around.
+leave new folders around. A write that fails (disk full, permission denied, a read-only file
+system) is one :class:`~rigedit.errors.RigWriteError` naming the user's path
+(:func:`write_error`, :func:`writing`), and the temporary file is removed.
 """
 from __future__ import annotations
 
@@ -12,10 +14,31 @@ import os
 import tempfile
 from pathlib import Path
 
-from ..errors import RigFileError
+from ..errors import RigFileError, RigWriteError
 
 __all__ = ["atomic_write", "write_json", "temp_beside", "check_output_folder",
-           "fsync_folder", "naming_target"]
+           "fsync_folder", "naming_target", "write_error", "writing"]
+
+def write_error(exc, path):
+    """``exc`` (an ``OSError`` of a write) as the :class:`RigWriteError` naming ``path``, the
+    user's file or folder; other exceptions are returned as they are."""
+    if isinstance(exc, RigFileError) or not isinstance(exc, OSError):
+        return exc
+    # the system's own words ("No space left on device", "Read-only file system")
+    problem = exc.strerror or str(exc) or type(exc).__name__
+    return RigWriteError(path, f"cannot write: {problem}", exc.errno, exc.strerror or str(exc))
+
+
+@contextlib.contextmanager
+def writing(path):
+    """Turn an ``OSError`` raised in the block into :func:`write_error` naming ``path``."""
+    try:
+        yield
+    except OSError as exc:
+        new = write_error(exc, path)
+        if new is exc:
+            raise
+        raise new from None
 
 
 def check_output_folder(path):
@@ -61,7 +84,7 @@ def temp_beside(path, suffix=None):
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or ".tmp",
                                    dir=path.parent)
     except OSError as exc:  # say which file could not be written, not the temporary name
-        raise type(exc)(exc.errno, exc.strerror, str(path)) from None
+        raise write_error(exc, path) from None
     try:
         try:
             mode = path.stat().st_mode & 0o777
@@ -98,7 +121,7 @@ def atomic_write(path, mode="w", suffix=None):
     except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
-        new = naming_target(exc, tmp, path)
+        new = write_error(exc, path)
         if new is exc:
             raise
         raise new from None

@@ -25,8 +25,9 @@ from .data import RigData, RigMeta, WeightsComputedWarning, build_rig
 from .frames import change_axes, resolve_folder_frames
 from .jsonfile import choice, name, read_json, relative_path
 from .mesh import MESH_SUFFIXES, load_mesh
-from .rig_save import recover_interrupted_save, remember_clip_files, save_rig_folder_atomic
-from .paths import list_folder, what_is
+from .rig_save import (STAGING, folder_lock, recover_interrupted_save, remember_clip_files,
+                       save_rig_folder_atomic)
+from .paths import list_folder, os_problem, what_is
 from .skeleton_json import UP_AXES, load_skeleton
 from .weights_npz import load_weights, weights_vertex_count
 
@@ -127,10 +128,28 @@ def read_rig_folder(folder):
     welded: the elk layout's OBJ exports split vertices at seams); ``meta.clip_files`` names
     the file of every clip, ``meta.notes["frames"]`` an axis decision. Warns
     ``UnknownJointsWarning`` for clips naming joints the skeleton lacks.
+
+    The read holds a shared lock on the folder (:func:`~rigedit.io.rig_save.folder_lock`),
+    which a save holds exclusively: a load while another process saves the same folder
+    waits for it and reads the old state or the new one whole, never a mix of the two.
     """
     folder = Path(folder)
-    if _is_dir(folder):
-        recover_interrupted_save(folder)   # a save killed part-way: finish or undo it
+    try:
+        for _ in range(3):
+            if _is_dir(folder):
+                recover_interrupted_save(folder)   # a save killed part-way: finish or undo it
+            with folder_lock(folder, shared=True):
+                if _is_dir(folder) and (folder / STAGING).exists():
+                    continue   # a save was killed between the recovery and the lock
+                return _read(folder)
+        raise RigFileError(folder, "expected the folder to stay still while it is read, got "
+                                   "saves interrupted again and again")
+    except OSError as exc:   # an unreadable folder (chmod 000), a name the system refuses
+        raise RigFileError(getattr(exc, "filename", None) or folder, os_problem(exc)) \
+            from None
+
+
+def _read(folder):
     files = find_rig_files(folder)
     skeleton, meta = load_skeleton(files["skeleton"])
 

@@ -40,8 +40,8 @@ import threading
 from pathlib import Path, PurePosixPath
 
 from ..animation.clip_names import check_clip_name
-from ..errors import RigFileError
-from .atomic import check_output_folder, fsync_folder, write_json
+from ..errors import RigFileError, RigWriteError
+from .atomic import check_output_folder, fsync_folder, write_error, write_json
 from .bundled import is_bundled
 from .clip_files import (ANIMATIONS, clip_entry, loaded_clip_files, plan_clip_files,
                          remember_clip_files)
@@ -98,6 +98,9 @@ def save_rig_folder_atomic(folder, rig, mesh_name="mesh.obj", allow_bundled=Fals
 
     Raises
     ------
+    RigWriteError
+        The folder cannot be written (disk full, permission denied, read-only): named, not
+        its hidden staging folder; the folder is as it was (one this save created is removed).
     RigFileError
         A bundled folder, a missing parent folder, a foreign clip file in the way.
     ValueError
@@ -114,10 +117,30 @@ def save_rig_folder_atomic(folder, rig, mesh_name="mesh.obj", allow_bundled=Fals
     if len(set(names)) != len(names):
         raise ValueError(f"expected distinct clip names, got {sorted(names)}")
     check_output_folder(folder)
-    folder.mkdir(exist_ok=True)
-    with folder_lock(folder):
-        _recover(folder)
-        return _save(folder, rig, names, mesh_name)
+    created = not (folder.exists() or folder.is_symlink())
+    try:
+        folder.mkdir(exist_ok=True)
+        with folder_lock(folder):
+            _recover(folder)
+            return _save(folder, rig, names, mesh_name)
+    except BaseException as exc:
+        if created:   # a new folder that did not get the rig: nothing is left behind
+            with contextlib.suppress(OSError):
+                _remove_tree(folder)
+        raise _named(exc, folder) from None
+
+
+def _named(exc, folder):
+    """A write error of the save, naming the rig folder (the user's path) rather than the
+    staging file or folder it happened to; other exceptions as they are."""
+    if isinstance(exc, RigWriteError):
+        return RigWriteError(folder, exc.problem, exc.errno, exc.strerror)
+    new = write_error(exc, folder)
+    if new is not exc:
+        return new
+    if isinstance(exc, RigFileError) and STAGING in Path(exc.path).parts:
+        return RigWriteError(folder, exc.problem)
+    return exc
 
 
 def _save(folder, rig, names, mesh_name):
@@ -269,7 +292,8 @@ def _recover(folder):
             _remove_tree(stage)
             return "discarded"
         _apply(folder, _read_journal(stage / JOURNAL))
-    except OSError as exc:
-        raise RigFileError(stage, f"an interrupted save could not be finished: "
-                                  f"{exc.strerror or exc}") from None
+    except OSError as exc:   # named by the rig folder: the staging folder is rigedit's own
+        raise RigWriteError(folder, f"an interrupted save could not be finished: "
+                                    f"{exc.strerror or exc}", exc.errno, exc.strerror) \
+            from None
     return "completed"

@@ -181,9 +181,11 @@ def test_a_folder_that_refuses_the_temporary_file_is_reported_as_the_target(tmp_
         raise PermissionError(13, "Permission denied", f"{dir}/{prefix}abc{suffix}")
 
     monkeypatch.setattr(tempfile, "mkstemp", refuse)
-    with pytest.raises(PermissionError) as info:
+    from rigedit.errors import RigWriteError   # an OSError too, with errno EACCES
+
+    with pytest.raises(RigWriteError) as info:
         write_json(tmp_path / "x.json", {})
-    assert info.value.filename == str(tmp_path / "x.json")
+    assert info.value.filename == str(tmp_path / "x.json") and info.value.errno == 13
     assert "Permission denied" in str(info.value) and ".x.json." not in str(info.value)
 
 
