@@ -19,6 +19,8 @@ from rigedit.rig import Rig
 from testpaths import DATA
 
 ROBOT = DATA / "threejs-characters" / "RobotExpressive.glb"
+#: The hat's primitive in the figure read back: parts come in node order, node 3 first.
+HAT = 0
 
 
 def _get(attrs, name):
@@ -111,7 +113,7 @@ def test_two_skins_and_rigid_parts_skin_like_the_spec(tmp_path, conflict):
     assert "skins" in data.meta.notes and "parts" in data.meta.notes
     assert "pre-transformed" in data.meta.notes["skins"]
     # the hat is wholly the head's, the static base the root's
-    hat = data.surface.vertex_primitive == 2
+    hat = data.surface.vertex_primitive == HAT
     assert np.all(data.indices[hat][:, 0] == names.index("head"))
     assert np.all(data.weights[hat][:, 0] == 1)
     rig = Rig.from_data(data)
@@ -187,7 +189,7 @@ def test_rigid_parts_and_skins_export_back_the_same_way(tmp_path, trees):
     # the rigid parts went out as skinned primitives, each vertex wholly on its joint
     g = Reference(out).g
     assert len(g.meshes[0].primitives) == len(set(first.surface.vertex_primitive.tolist()))
-    hat = np.flatnonzero(first.surface.vertex_primitive == 2)
+    hat = np.flatnonzero(first.surface.vertex_primitive == HAT)
     dense = again.binding.dense()
     assert np.all(dense[hat, first.skeleton.names.index("head")] == 1)
     clip_a, clip_b = first.clips["move"], again.clips["move"]
@@ -216,3 +218,21 @@ def test_a_deep_node_chain_reads_in_linear_time(tmp_path):
     assert np.allclose(data.vertices[-4:, 0], np.array([-0.05, 0.05, -0.05, 0.05]) + 5.0,
                        atol=1e-6)
     assert spent < 6.0, spent
+
+
+@pytest.mark.parametrize("scale", [[0.5, 0.5, 0.5], [-0.5, 0.5, 0.5]])
+def test_a_mirrored_rigid_part_keeps_its_faces_facing_out(tmp_path, scale):
+    """A rigid part's faces stay on the side of its normals (transformed by the inverse
+    transpose) when its placement mirrors it: the winding is reversed, as a viewer does for a
+    node of negative determinant."""
+    b, _ = two_skins_and_parts()
+    b.doc["nodes"][3]["scale"] = scale
+    path = b.write(tmp_path / "mirrored.glb")
+    data = read_gltf(path)
+    hat = data.surface.vertex_primitive == HAT
+    faces = data.faces[np.all(hat[data.faces], axis=1)]
+    v = data.vertices
+    face_n = np.cross(v[faces[:, 1]] - v[faces[:, 0]], v[faces[:, 2]] - v[faces[:, 0]])
+    vert_n = data.surface.normals[faces[:, 0]]
+    assert len(faces) and np.all(np.sum(face_n * vert_n, axis=1) > 0)
+    assert worst(path, Rig.from_data(data)) < 1e-6
