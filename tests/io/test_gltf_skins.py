@@ -116,6 +116,13 @@ def test_two_skins_and_rigid_parts_skin_like_the_spec(tmp_path, conflict):
     hat = data.surface.vertex_primitive == HAT
     assert np.all(data.indices[hat][:, 0] == names.index("head"))
     assert np.all(data.weights[hat][:, 0] == 1)
+    base = data.surface.vertex_primitive == data.surface.vertex_primitive.max()   # node 8
+    assert np.all(data.indices[base][:, 0] == 0) and np.all(data.weights[base][:, 0] == 1)
+    # the arm's head vertices ride the helper joint where skin 2's bind differs
+    arm = data.surface.vertex_primitive == 4
+    top = data.weights[arm][:, 1] > 0
+    want = names.index("head.skin2") if conflict else names.index("head")
+    assert np.all(data.indices[arm][top, 1] == want)
     rig = Rig.from_data(data)
     assert worst(path, rig) < 1e-6
 
