@@ -23,6 +23,11 @@ class RigFileError(ValueError):
         self.problem = re.sub(r"\s*[\r\n]+\s*", " ", str(problem))
         super().__init__(f"{self.path}: {self.problem}")
 
+    def __reduce__(self):
+        # picklable with its two arguments (an FBX read in a child process sends its error
+        # back: rigedit.io.fbx_isolated)
+        return type(self), (self.path, self.problem)
+
 
 class RigWriteError(RigFileError, OSError):
     """A file or rig folder could not be written (disk full, permission denied, a read-only
@@ -44,6 +49,9 @@ class RigWriteError(RigFileError, OSError):
     def __init__(self, path, problem, errno=None, strerror=None):
         super().__init__(path, problem)
         self.errno, self.strerror, self.filename = errno, strerror, self.path
+
+    def __reduce__(self):
+        return type(self), (self.path, self.problem, self.errno, self.strerror)
 
     def __str__(self):
         return f"{self.path}: {self.problem}"

@@ -9,7 +9,8 @@ of clip names. A new format is one reader, one writer and one line of :data:`FOR
 ``gltf``    ``.glb``, ``.gltf``   :mod:`rigedit.io.gltf_read`, :mod:`rigedit.io.gltf_write`
 ``bvh``     ``.bvh``              :mod:`rigedit.io.bvh`, :mod:`rigedit.io.bvh_write`: a
                                   skeleton and one clip, no mesh
-``fbx``     ``.fbx``              :mod:`rigedit.io.fbx_read` (through ufbx),
+``fbx``     ``.fbx``              :mod:`rigedit.io.fbx_read` (through ufbx, in a child
+                                  process: :mod:`rigedit.io.fbx_isolated`),
                                   :mod:`rigedit.io.fbx_write` (binary FBX 7.4)
 ==========  ====================  =================================================
 """
@@ -22,7 +23,7 @@ from typing import Callable, Tuple
 from ..errors import RigFileError
 from .bvh import read_bvh
 from .bvh_write import write_bvh
-from .fbx_read import read_fbx
+from .fbx_isolated import read_fbx  # fbx_read's reader, in a child process (see there)
 from .fbx_write import write_fbx
 from .gltf_read import read_gltf
 from .gltf_write import save_gltf
@@ -46,7 +47,7 @@ class Format:
 
 FORMATS = (
     Format("folder", (), read_rig_folder, write_rig_folder),
-    Format("gltf", (".glb", ".gltf"), read_gltf, save_gltf),
+    Format("gltf", (".glb", ".gltf"), read_gltf, save_gltf, options=("allow_outside_uris",)),
     Format("bvh", (".bvh",), read_bvh, write_bvh, options=("scale",)),
     Format("fbx", (".fbx",), read_fbx, write_fbx),
 )
