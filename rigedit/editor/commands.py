@@ -25,14 +25,17 @@ from .clip_commands import (add_clip, delete_clip, duplicate_clip, new_clip, ren
                             set_duration, unique_clip_name)
 from .deform import set_joint_deform
 from .drag import PoseDrag
-from .files import export_rig, open_document, open_rig, save_rig_folder
+from .autorig import open_autorigged
+from .files import (export_pose, export_rig, export_skeleton, load_weights, open_document,
+                    open_rig, save_rig_folder, save_weights)
 from .key_commands import (KeyDrag, copy_keys, delete_key, key_near, move_keys, paste_keys,
                            set_interpolation, set_key)
 from .morphs import WeightDrag, delete_weight_key, key_weight, set_weight
 from .recompute import RecomputeWeights, recompute_weights
 from .weight_stroke import WeightStroke
 
-__all__ = ["open_document", "open_rig", "save_rig_folder", "export_rig", "PoseDrag",
+__all__ = ["open_document", "open_rig", "save_rig_folder", "export_rig", "export_pose",
+           "export_skeleton", "load_weights", "save_weights", "open_autorigged", "PoseDrag",
            "set_key", "key_near", "delete_key", "move_keys", "KeyDrag", "copy_keys", "paste_keys",
            "set_interpolation", "new_clip", "add_clip", "rename_clip", "duplicate_clip",
            "delete_clip", "set_duration", "unique_clip_name", "WeightStroke",

@@ -117,9 +117,9 @@ class DragController:
     Attributes
     ----------
     drag : dict or None
-        The drag under way: ``joint``, ``start`` (3,), ``axis``, ``pose`` (the snapshot at
-        the press), ``ik`` (the :class:`PoseDrag` of a pose-mode drag), ``target`` (3,) once
-        moved, ``heads`` (J, 3) the rest heads shown by an edit-mode drag.
+        The drag under way: ``joint``, ``start`` (3,), ``axis``, ``ik`` (the
+        :class:`PoseDrag` of a pose-mode drag, which holds the pose at the press), ``target``
+        (3,) once moved, ``heads`` (J, 3) the rest heads shown by an edit-mode drag.
     """
 
     def __init__(self, document, scene, gizmos, axes, settings, move_rest, status,
@@ -146,8 +146,7 @@ class DragController:
         d = self.document
         d.select(j)
         self.drag = {"joint": j, "start": self.gizmos.center(j),
-                     "axis": self.settings.axis if axis is None else axis,
-                     "pose": d.pose_snapshot()}
+                     "axis": self.settings.axis if axis is None else axis}
         if d.mode == "pose":
             self.drag["ik"] = PoseDrag(d, j, self.settings.chain_length)
 

@@ -10,7 +10,31 @@ from __future__ import annotations
 
 from ..binding import compute_weights, default_method
 
-__all__ = ["RecomputeWeights", "recompute_weights"]
+__all__ = ["RecomputeWeights", "recompute_weights", "compute_weights_for"]
+
+
+def compute_weights_for(vertices, skeleton, method=None, progress=None, faces=None):
+    """Skin weights of ``vertices`` for ``skeleton`` (the slow work of a recompute, an
+    edit-mode re-bind or a mesh opened with a skeleton; safe in a worker thread).
+
+    Parameters
+    ----------
+    vertices : (V, 3) float64
+    skeleton : Skeleton
+    method : {"heat", "idw"}, optional
+        Bone heat for a mesh with ``faces``, inverse distance for a point cloud, by default.
+    progress : callable, optional
+        ``progress(fraction, stage=None)`` (:mod:`rigedit.progress`); its
+        :class:`~rigedit.progress.Cancelled` stops the work.
+    faces : (F, 3) int, optional
+
+    Returns
+    -------
+    indices : (V, K) int32
+    weights : (V, K) float64
+    """
+    method = method or default_method(faces)
+    return compute_weights(vertices, skeleton, method, progress=progress, faces=faces)
 
 
 class RecomputeWeights:
@@ -47,8 +71,8 @@ class RecomputeWeights:
             if progress is not None:
                 progress(fraction, stage or self.method)
 
-        return compute_weights(self.rig.vertices, self.skeleton, self.method,
-                               progress=relay, faces=self.rig.faces)
+        return compute_weights_for(self.rig.vertices, self.skeleton, self.method,
+                                   progress=relay, faces=self.rig.faces)
 
     def apply(self, result):
         """Make ``result`` (from :meth:`compute`) the weights, as one undo step.

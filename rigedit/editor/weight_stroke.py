@@ -1,16 +1,20 @@
 """One stroke of the weight brush: a working copy of the skin weights, painted dab by dab,
 that becomes one undo step when the mouse is released.
 
-The maths of a dab is :mod:`rigedit.binding.weight_paint`'s; the mouse handling that makes
-strokes is :class:`~rigedit.ui.weight_brush.WeightBrush`'s. No Qt or VTK here.
+The maths of a dab is :mod:`rigedit.binding.weight_paint`'s (its brush modes are
+:data:`MODES`); the mouse handling that makes strokes is
+:class:`~rigedit.ui.weight_brush.WeightBrush`'s. :class:`BrushTables` keeps what dabs need
+beyond the weights. No Qt or VTK here.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..binding.weight_paint import brush_vertices, joint_column, paint, paint_mirrored
+from ..binding.weight_paint import (MODES, brush_vertices, joint_column, mirror_vertices,
+                                    paint, paint_mirrored, vertex_adjacency)
+from .mirror import side_axis
 
-__all__ = ["WeightStroke"]
+__all__ = ["WeightStroke", "BrushTables", "MODES"]
 
 
 class WeightStroke:
@@ -105,3 +109,41 @@ class WeightStroke:
         name = d.skeleton.names[self.joint]
         d.set_weights(self.indices, self.weights, label=f"Paint {name}")
         return f"Painted {name} ({self.dabs} dabs); Ctrl+Z undoes the stroke"
+
+
+class BrushTables:
+    """What dabs need beyond the weights, computed once per rig and kept while it is the
+    document's (the first dab of a smooth or mirrored stroke pays for it, the others not).
+
+    Parameters
+    ----------
+    document : Document
+    """
+
+    def __init__(self, document):
+        self.document = document
+        self._tables = {}
+
+    def clear(self):
+        """Forget the tables (a rig was opened: the next dab computes them again)."""
+        self._tables = {}
+
+    def _table(self, key, make):
+        rig = self.document.rig
+        if self._tables.get("rig") is not rig:
+            self._tables = {"rig": rig}
+        if key not in self._tables:
+            self._tables[key] = make(rig)
+        return self._tables[key]
+
+    def adjacency(self):
+        """(V, V) sparse: the rig's vertex adjacency (the ``"smooth"`` mode's)."""
+        return self._table("adjacency", lambda rig: vertex_adjacency(rig.faces,
+                                                                      len(rig.vertices)))
+
+    def mirror(self):
+        """(V,) int: each rest vertex's mirror image across the skeleton's left-right axis
+        (-1: none), for a mirrored stroke."""
+        d = self.document
+        axis = side_axis(d.skeleton, d.mirror)
+        return self._table(("mirror", axis), lambda rig: mirror_vertices(rig.vertices, axis))

@@ -51,15 +51,15 @@ def main(argv=None, prog="rigedit-editor"):
     threadpool_limits(1)
     app = _application()
 
-    import rigedit
     from PyQt5 import QtCore
 
+    from ..editor.files import load_rig
     from . import MainWindow
 
     rig = None
     if args.rig is not None:
         try:
-            rig = rigedit.load_rig(args.rig)
+            rig = load_rig(args.rig)
         except (ValueError, OSError) as exc:
             print(f"{prog}: {exc}", file=sys.stderr)
             return 2
@@ -83,9 +83,9 @@ def main(argv=None, prog="rigedit-editor"):
     QtCore.QTimer.singleShot(0, window.autosave.offer_recovery)
     # The compiled skinning kernels load (from numba's disk cache) in the background once the
     # window is up, so they neither delay the first frame nor get compiled during a drag.
-    from ..model import skinning_kernels
+    from ..editor.warm_up import start_loading_kernels
 
-    QtCore.QTimer.singleShot(500, skinning_kernels.start_loading)
+    QtCore.QTimer.singleShot(500, start_loading_kernels)
     return app.exec_()
 
 

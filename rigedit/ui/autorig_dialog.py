@@ -15,6 +15,7 @@ from pathlib import Path
 
 from PyQt5 import QtWidgets
 
+from ..editor.autorig import autorig_mesh, describe_report, open_autorigged
 from .menus import make_action
 
 __all__ = ["AutorigDialog", "AutorigAction", "AXES", "describe_report"]
@@ -37,44 +38,6 @@ def template_path(path):
     if path.name.lower() == "skeleton.json" and (folder / "rig.json").is_file():
         return folder
     return path
-
-
-def describe_report(report):
-    """One line for the status bar from ``rig.autorig_report``
-    (:class:`rigedit.rigging.autorig.pipeline.AutorigReport`): NOT SURE and the first reason when a
-    check failed, the orientation used and whether it was guessed (and sure), the template
-    clips that came along, and each stage's time.
-
-    Returns
-    -------
-    str
-    """
-    if report is None:
-        return ""
-    from ..rigging.autorig.orient import axis_name
-
-    o = report.orientation
-    how = "given" if not o.guessed else ("guessed" if o.sure else
-                                         "guessed, NOT SURE: check it, or choose Up and "
-                                         "Forward in the dialog")
-    parts = [f"up {axis_name(o.up)}, forward {axis_name(o.forward)} ({how})"]
-    reasons = getattr(report, "reasons", [])
-    if not getattr(report, "sure", True) and reasons:
-        # the first reason in full (the joints in doubt are selected), the count of others
-        parts.insert(0, f"NOT SURE: {reasons[0]}"
-                     + (f" (and {len(reasons) - 1} more)" if len(reasons) > 1 else ""))
-    left_out = [name for name, how in report.clips.items() if how != "retargeted"]
-    if left_out:
-        parts.append(f"clips left out: {', '.join(left_out)}")
-    seconds = report.seconds
-    # the embedding's own stages ("embedding/search") are inside its total: top level only
-    top = {k: v for k, v in seconds.items()
-           if not k.startswith("embedding/") and k != "total"}
-    if top:
-        total = seconds.get("total", sum(top.values()))
-        parts.append(f"{total:.1f} s (" + ", ".join(f"{k} {v:.1f} s" for k, v in top.items())
-                     + ")")
-    return "; ".join(parts)
 
 
 class AutorigDialog(QtWidgets.QDialog):
@@ -233,12 +196,9 @@ class AutorigAction:
         label = f"Auto-rigging {mesh.name}"
 
         def work(report):
-            from rigedit import autorig
-
-            report(0.0)
             # report raises Cancelled after the Cancel button; the bar names each stage
-            return autorig(str(mesh), template=template, up=up, forward=forward,
-                           progress=report)
+            return autorig_mesh(mesh, template=template, up=up, forward=forward,
+                                progress=report)
 
         return self.services.run_job(label, work, lambda rig: self._done(mesh, rig, check),
                                      show_stage=True)
@@ -246,17 +206,5 @@ class AutorigAction:
     def _done(self, mesh, rig, check=lambda: True):
         if not check():
             return None
-        rig.path = None  # a new document: Save asks where
-        if not rig.name:
-            rig.name = mesh.stem
-        self.document.set_rig(rig, modified=True)
-        self.document.set_mode("edit")   # the window follows the mode event
-        doubtful = [n for n in getattr(rig.meta.autorig_report, "doubtful", [])
-                    if n in rig.skeleton.index]
-        if doubtful:   # the first joint in doubt, ready to drag (the status bar says why)
-            self.document.select(rig.skeleton.index[doubtful[0]])
-        about = describe_report(rig.meta.autorig_report)
-        # short enough for the status bar beside the mode label; counts are in Info
-        self.services.status(f"Auto-rigged {mesh.name}" + (f": {about}" if about else "")
-                      + "; drag joints to fix them")
+        self.services.status(open_autorigged(self.document, rig, mesh))
         return rig

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from PyQt5 import QtCore, QtWidgets
 
-from ..binding.weight_paint import MODES
+from ..editor.weight_stroke import MODES
 
 __all__ = ["BrushPanel"]
 

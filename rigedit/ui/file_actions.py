@@ -4,49 +4,16 @@ current rig.
 """
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
 from PyQt5 import QtWidgets
 
-from ..io.atomic import write_json
-from ..io.rig_folder import load_rig_folder, save_rig_folder
-from ..io.rig_save import is_bundled
-from ..io.skeleton_json import save_skeleton
-from ..io.weights_npz import load_weights, save_weights
-from .jobs import weights_in_chunks
+from ..editor import files
+from ..editor.files import pose_to_dict  # noqa: F401 - its old home
+from ..editor.recompute import RecomputeWeights
 from .menus import make_action
 
 __all__ = ["FileActions", "pose_to_dict"]
-
-
-def pose_to_dict(pose):
-    """JSON-ready description of a pose (local transforms and Euler angles from rest)."""
-    joints = {}
-    for j, name in enumerate(pose.skeleton.names):
-        joints[name] = {"translation": pose.translation[j].round(9).tolist(),
-                        "rotation": pose.rotation[j].round(12).tolist(),
-                        "scale": pose.scale[j].round(9).tolist(),
-                        "euler_degrees_from_rest": pose.get_euler(j, degrees=True)
-                        .round(6).tolist()}
-    return {"format": "rigedit.pose", "version": 1, "rotation_order": "xyzw",
-            "joints": joints}
-
-
-def _load_folder(path):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # "weights computed" is expected, not an error
-        return load_rig_folder(path)
-
-
-def _load_file(path):
-    """A glTF/GLB or BVH file as a rig; what the reader decided (a BVH's unit guess) is in
-    ``rig.notes`` for the status bar, so its warning is not needed here."""
-    import rigedit
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return rigedit.load_rig(path)
 
 
 class FileActions:
@@ -153,7 +120,8 @@ class FileActions:
                                                                   "Open rig folder")
         if not path:
             return None
-        return self._run(f"Opening {Path(path).name}", lambda report: _load_folder(path),
+        return self._run(f"Opening {Path(path).name}",
+                         lambda report: files.load_rig_folder(path),
                          lambda rig: self._opened(rig, check))
 
     def open_mesh_skeleton(self, mesh_path=None, skeleton_path=None):
@@ -170,17 +138,7 @@ class FileActions:
             return None
 
         def work(report):
-            from ..io.mesh import load_mesh
-            from ..io.skeleton_json import load_skeleton
-            from ..rig import Rig
-
-            report(None)
-            skeleton, meta = load_skeleton(skeleton_path)
-            vertices, faces = load_mesh(mesh_path)
-            indices, weights = weights_in_chunks(vertices, skeleton, report=report,
-                                                 faces=faces)
-            return Rig(skeleton, vertices, faces, indices, weights, name=Path(mesh_path).stem,
-                       up=meta["up"])
+            return files.load_mesh_skeleton(mesh_path, skeleton_path, progress=report)
 
         return self._run(f"Opening {Path(mesh_path).name}", work,
                          lambda rig: self._opened(rig, check))
@@ -194,7 +152,9 @@ class FileActions:
                                       "Rigs and motion (*.glb *.gltf *.fbx *.bvh)")
         if not path:
             return None
-        return self._run(f"Opening {Path(path).name}", lambda report: _load_file(path),
+        # what the reader decided (a BVH's unit guess) is in rig.notes for the status bar
+        return self._run(f"Opening {Path(path).name}",
+                         lambda report: files.load_rig(path, quiet=True),
                          lambda rig: self._opened(rig, check))
 
     def _opened(self, rig, check):
@@ -210,7 +170,7 @@ class FileActions:
         """Save into the folder the rig came from; a rig without one, or a bundled character
         (read-only), asks for a new place (Save As)."""
         path = self.doc.rig.path
-        if path is None or not Path(path).is_dir() or is_bundled(path):
+        if path is None or not Path(path).is_dir() or files.is_bundled(path):
             return self.save_as()
         return self.save_to(path)
 
@@ -224,7 +184,7 @@ class FileActions:
         current = self.doc.rig.path
         other_rig = (Path(path) / "rig.json").is_file() and not (
             current is not None and Path(current).resolve() == Path(path).resolve())
-        if other_rig and not is_bundled(path) and not self._confirm_replace(path):
+        if other_rig and not files.is_bundled(path) and not self._confirm_replace(path):
             return None
         return self.save_to(path)
 
@@ -247,39 +207,32 @@ class FileActions:
 
     def save_to(self, path):
         """Write the rig folder (each file atomically); the status bar says where."""
+        # the document then has no unsaved changes: the title loses its star, autosave rests
         rig = self.doc.rig
-        if not self._attempt("Save rig", lambda: save_rig_folder(path, rig),
-                             f"Saved {rig.name} to {path}"):
-            return False
-        rig.path = Path(path)
-        self.doc.mark_saved()  # no unsaved changes: the title loses its star, autosave rests
-        return True
+        return self._attempt("Save rig", lambda: files.save_rig_folder(self.doc, path),
+                             f"Saved {rig.name} to {path}")
 
     def export_pose(self, path=None):
         path = path or self._ask_save("Export pose", "pose.json", "JSON (*.json)")
         return bool(path) and self._attempt(
-            "Export pose", lambda: write_json(path, pose_to_dict(self.doc.pose)),
+            "Export pose", lambda: files.export_pose(self.doc, path),
             f"Exported the pose to {path}")
 
     def export_skeleton(self, path=None):
         path = path or self._ask_save("Export skeleton", "skeleton.json", "JSON (*.json)")
         return bool(path) and self._attempt(
-            "Export skeleton", lambda: save_skeleton(path, self.doc.skeleton, up=self.doc.rig.up),
+            "Export skeleton", lambda: files.export_skeleton(self.doc, path),
             f"Exported the skeleton to {path}")
 
     def export(self, path=None):
         """Export the rig as glTF (.glb/.gltf, every clip) or BVH (the skeleton and the
         current clip); the format follows the extension."""
-        rig, clip = self.doc.rig, self.doc.current_clip
+        rig = self.doc.rig
         path = path or self._ask_save("Export", f"{rig.name}.glb",
                                       "glTF binary (*.glb);;glTF (*.gltf);;BVH (*.bvh)")
         if not path:
             return False
-        from ..io.save import save_rig
-
-        bvh = Path(path).suffix.lower() == ".bvh"
-        clips = [clip] if bvh and clip is not None else None
-        return self._attempt("Export", lambda: save_rig(rig, path, clips=clips),
+        return self._attempt("Export", lambda: files.export_rig(self.doc, path),
                              f"Exported {rig.name} to {path}")
 
     # ------------------------------------------------------------------ weights
@@ -288,20 +241,13 @@ class FileActions:
         path = path or self._ask_open("Load weights", "Weights (*.npz)")
         if not path:
             return False
-        rig = self.doc.rig
-
-        def load():
-            indices, weights = load_weights(path, rig.skeleton, len(rig.vertices))
-            self.doc.set_weights(indices, weights, label=f"Load weights {Path(path).name}")
-
-        return self._attempt("Load weights", load, f"Loaded weights from {path}")
+        return self._attempt("Load weights", lambda: files.load_weights(self.doc, path),
+                             f"Loaded weights from {path}")
 
     def save_weights(self, path=None):
         path = path or self._ask_save("Save weights", "weights.npz", "Weights (*.npz)")
-        b = self.doc.rig.binding
         return bool(path) and self._attempt(
-            "Save weights", lambda: save_weights(path, b.indices, b.weights,
-                                                 self.doc.skeleton.names),
+            "Save weights", lambda: files.save_weights(self.doc, path),
             f"Saved weights to {path}")
 
     def recompute_weights(self, method=None):
@@ -309,25 +255,9 @@ class FileActions:
         ``method`` is ``"heat"`` or ``"idw"``; by default heat for a mesh with faces."""
         if not isinstance(method, str):  # a menu action's "checked" argument
             method = None
-        rig = self.doc.rig
-        vertices, skeleton = rig.vertices, rig.skeleton
-
-        def done(result):
-            if self.doc.rig is not rig or self.doc.skeleton is not skeleton:
-                # Weights for another rig or skeleton (opened, or a rest edit undone or
-                # redone meanwhile) must not be applied to this one.
-                what = "another rig was opened" if self.doc.rig is not rig else \
-                    "the skeleton changed"
-                self.status(f"Recomputed weights dropped: {what} while they were "
-                            f"computed; recompute them again")
-                return
-            self.doc.set_weights(*result, label="Recompute weights")
-            self.status(f"Recomputed weights for {len(vertices):,} vertices")
-
-        return self._run("Computing weights",
-                         lambda report: weights_in_chunks(vertices, skeleton, method=method,
-                                                          report=report,
-                                                          faces=rig.faces), done)
+        job = RecomputeWeights(self.doc, method)   # what the document holds now
+        return self._run("Computing weights", job.compute,
+                         lambda result: self.status(job.apply(result)[0]))
 
     def save_screenshot(self, path=None):
         path = path or self._ask_save("Save screenshot", "rigedit.png", "PNG (*.png)")

@@ -1,5 +1,5 @@
 """File > Import motion onto this character: retarget a BVH, glTF or rig folder's clip onto
-the open rig (:func:`rigedit.rigging.retarget_result`) and add it as a new clip.
+the open rig and add it as a new clip; the work is :mod:`rigedit.editor.import_motion`'s.
 
 Reading the motion and retargeting run off the UI thread (:class:`~rigedit.ui.jobs.JobRunner`; the
 retarget cannot report its progress, so the bar is indeterminate). The joint map used is then
@@ -12,14 +12,13 @@ document is left as it was; when the retarget fails, the map stays open to be me
 """
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 from types import SimpleNamespace
 
 from PyQt5 import QtWidgets
 
-from ..animation.clip_names import check_clip_name
-from ..rigging.retarget.name_map import unmapped_parts
+from ..editor import import_motion as motion
+from ..editor.import_motion import motion_path
 from .menus import make_action
 
 __all__ = ["ImportMotion", "motion_path"]
@@ -27,31 +26,6 @@ __all__ = ["ImportMotion", "motion_path"]
 MAP_FILTERS = "Joint map (*.json);;All files (*)"
 FILTERS = ("Motion (*.bvh *.glb *.gltf skeleton.json);;BVH (*.bvh);;glTF (*.glb *.gltf);;"
            "Rig folder (skeleton.json)")
-
-
-def motion_path(path):
-    """The path :func:`rigedit.load_rig` reads for a chosen file: a rig folder is chosen by
-    its ``skeleton.json`` (one file dialog for files and folders), other files as they are."""
-    path = Path(path)
-    return path.parent if path.name.lower() == "skeleton.json" else path
-
-
-def _load_motion(path):
-    import rigedit
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # a BVH's unit guess is expected, not an error
-        return rigedit.load_rig(path)
-
-
-def _clip_name(path, source_clip, several):
-    """The new clip's base name: the motion file's stem (the clip's own name when the file
-    holds several), or ``imported motion`` when that is no valid clip name."""
-    base = f"{path.stem} {source_clip}" if several else path.stem
-    try:
-        return check_clip_name(base.strip())
-    except ValueError:
-        return "imported motion"
 
 
 def _names(names, most=8):
@@ -100,7 +74,7 @@ class ImportMotion:
             return None
         path = motion_path(path)
         return self.services.run_job(f"Reading {path.name}",
-                                     lambda report: _load_motion(path),
+                                     lambda report: motion.read_motion(path),
                                      lambda source: self._loaded(path, source))
 
     def _loaded(self, path, source):
@@ -118,13 +92,8 @@ class ImportMotion:
         doc = self.document
         # the job reads a snapshot of the clips: the user may edit them meanwhile
         ctx = SimpleNamespace(path=path, source=source, clip=name, rig=doc.rig,
-                              skeleton=doc.skeleton, res=None,
-                              # the binding too, so the soles are held on the skin; a
-                              # re-bind replaces it (never edits it), so this is a snapshot
-                              target=SimpleNamespace(skeleton=doc.skeleton,
-                                                     clips=dict(doc.clips),
-                                                     binding=doc.rig.binding),
-                              base=_clip_name(path, name, len(names) > 1))
+                              skeleton=doc.skeleton, res=None, target=motion.target_of(doc),
+                              base=motion.clip_name(path, name, len(names) > 1))
         self._close_dialog()
         self.ctx = ctx
         return self.retarget(None)
@@ -139,13 +108,11 @@ class ImportMotion:
         how = how or ("automatic" if mapping is None else "edited")
 
         def work(report):
-            from ..rigging import retarget_result
-
             report(None)
             try:
-                return retarget_result(ctx.source, ctx.clip, ctx.target, mapping,
-                                       source_what=str(ctx.path),
-                                       target_what=ctx.rig.name or "this character")
+                return motion.retarget_motion(ctx.source, ctx.clip, ctx.target, mapping,
+                                              source_what=str(ctx.path),
+                                              target_what=ctx.rig.name or "this character")
             except ValueError as exc:  # no legs mapped, ...: shown, and the map stays editable
                 return exc
 
@@ -165,29 +132,14 @@ class ImportMotion:
     def _retargeted(self, ctx, res, mapping, how):
         if ctx is not self.ctx:
             return None
-        n_source = len(ctx.source.skeleton)
-        n_target = len(ctx.skeleton)
         if isinstance(res, ValueError):
             ctx.res = None
             text = f"No clip: {res}"
             self.error("Import motion", str(res))
         else:
             ctx.res = res
-            mapped = len(res.mapping)
-            ctx.summary = (f"joint map {how}, {mapped} mapped, {n_target - mapped} of this "
-                           f"character's joints unmapped, {n_source - mapped} of the "
-                           f"motion's unused")
-            driven = set(res.mapping.values())
-            rest = [n for n in ctx.skeleton.names if n not in driven]
-            # what rigedit retarget warns about: whole body parts left out (one line each)
-            doubts = [f"NOT SURE: the map leaves parts unmapped: {'; '.join(missing)}"
-                      for missing in [unmapped_parts(res.target_calibration,
-                                                     [ctx.skeleton.index[t] for t in driven])]
-                      if missing]
-            if res.facing_note:
-                doubts.append(f"NOT SURE of the facing: {res.facing_note}")
-            if doubts:
-                ctx.summary += ". " + ". ".join(doubts)
+            ctx.summary, rest = motion.describe_result(res, ctx.source.skeleton, ctx.skeleton,
+                                                       how)
             text = (f"{ctx.path.name}, clip {ctx.clip!r} ({res.clip.duration:.2f} s): "
                     f"{ctx.summary}." + (f" Unmapped, kept at their rest pose: "
                                          f"{_names(rest)}." if rest else ""))
@@ -230,10 +182,8 @@ class ImportMotion:
                 self.dialog or self.parent, "Load joint map", "", MAP_FILTERS)
         if not path or ctx is None:
             return None
-        from ..rigging import load_map
-
         try:
-            mapping = load_map(path, ctx.source.skeleton, ctx.skeleton)
+            mapping = motion.load_map(path, ctx.source.skeleton, ctx.skeleton)
         except (ValueError, OSError) as exc:
             self.error("Load joint map", str(exc))
             return None
@@ -250,10 +200,8 @@ class ImportMotion:
                 self.dialog, "Save joint map", f"{self.ctx.path.stem}_map.json", MAP_FILTERS)
         if not path:
             return False
-        from ..rigging import save_map
-
         try:
-            save_map(path, self.dialog.mapping())
+            motion.save_map(path, self.dialog.mapping())
         except (ValueError, OSError) as exc:
             self.error("Save joint map", f"{path}: {exc}")
             return False
@@ -273,9 +221,8 @@ class ImportMotion:
             return None
         path, res = ctx.path, ctx.res
         doc = self.document
-        if doc.rig is not ctx.rig or doc.skeleton is not ctx.skeleton:
-            what = "another rig was opened" if doc.rig is not ctx.rig else \
-                "the skeleton changed"
+        what = motion.dropped_because(doc, ctx.rig, ctx.skeleton)
+        if what is not None:
             self.error("Import motion", f"{path}: import dropped: {what} while it was "
                                           f"retargeted; import it again")
             return None

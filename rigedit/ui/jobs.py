@@ -11,10 +11,9 @@ import threading
 
 from PyQt5 import QtCore, QtWidgets
 
-from ..binding.weights import compute_weights, default_method
 from ..progress import Cancelled  # the one way to stop a job (rigedit.progress)
 
-__all__ = ["Cancelled", "Job", "JobRunner", "weights_in_chunks"]
+__all__ = ["Cancelled", "Job", "JobRunner"]
 
 
 class Job(QtCore.QThread):
@@ -208,15 +207,3 @@ class JobRunner(QtCore.QObject):
         if on_cancel:
             on_cancel()
 
-
-def weights_in_chunks(vertices, skeleton, method=None, report=None, faces=None):
-    """Compute skin weights with progress: ``report(fraction)`` is called after each block
-    of vertices, and its :class:`Cancelled` stops the work between blocks.
-
-    Returns
-    -------
-    indices : (V, K) int32
-    weights : (V, K) float64
-    """
-    method = method or default_method(faces)  # heat for a mesh, idw for a point cloud
-    return compute_weights(vertices, skeleton, method, progress=report, faces=faces)

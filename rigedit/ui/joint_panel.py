@@ -59,13 +59,22 @@ class JointPanel(QtWidgets.QWidget):
         self.joint = None
         layout = QtWidgets.QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 6)
+        self._build_tree(layout)
+        layout.addWidget(self._rotation_group())
+        layout.addWidget(self._translation_scale_group())
+        layout.addLayout(self._buttons())
+        self._items = []
+        self._set_enabled(False)
+
+    # ------------------------------------------------------------------ widgets
+    def _build_tree(self, layout):
+        """The joint tree, the selected joint's name and its "deforms" box, into ``layout``."""
         self.tree = QtWidgets.QTreeWidget()
         self.tree.setHeaderHidden(True)
         self.tree.setUniformRowHeights(True)
         self.tree.setMinimumHeight(180)
         self.tree.itemSelectionChanged.connect(self._tree_selected)
         layout.addWidget(self.tree, 3)
-
         self.title = QtWidgets.QLabel("No joint selected")
         self.title.setStyleSheet("font-weight: bold; padding: 2px 0;")
         layout.addWidget(self.title)
@@ -76,6 +85,8 @@ class JointPanel(QtWidgets.QWidget):
             lambda on: self.joint is not None and self.deform_toggled.emit(self.joint, on))
         layout.addWidget(self.deform_box)
 
+    def _rotation_group(self):
+        """Rotation: a slider (tenths of a degree) and a spin box per axis."""
         rot = QtWidgets.QGroupBox("Rotation (degrees from rest)")
         grid = QtWidgets.QGridLayout(rot)
         grid.setContentsMargins(6, 4, 6, 4)
@@ -100,8 +111,10 @@ class JointPanel(QtWidgets.QWidget):
             grid.addWidget(box, k, 2)
             self.sliders.append(slider)
             self.angle_boxes.append(box)
-        layout.addWidget(rot)
+        return rot
 
+    def _translation_scale_group(self):
+        """Local translation (T) and scale (S): a spin box per axis each."""
         trs = QtWidgets.QGroupBox("Translation / scale (local)")
         grid = QtWidgets.QGridLayout(trs)
         grid.setContentsMargins(6, 4, 6, 4)
@@ -118,8 +131,10 @@ class JointPanel(QtWidgets.QWidget):
             self.scale_boxes.append(s)
         grid.addWidget(QtWidgets.QLabel("T"), 1, 0)
         grid.addWidget(QtWidgets.QLabel("S"), 2, 0)
-        layout.addWidget(trs)
+        return trs
 
+    def _buttons(self):
+        """Reset joint, reset pose, mirror left onto right and right onto left."""
         buttons = QtWidgets.QGridLayout()
         self.reset_joint_button = QtWidgets.QPushButton("Reset joint")
         self.reset_joint_button.clicked.connect(
@@ -134,9 +149,7 @@ class JointPanel(QtWidgets.QWidget):
         buttons.addWidget(self.reset_pose_button, 0, 1)
         buttons.addWidget(self.mirror_lr_button, 1, 0)
         buttons.addWidget(self.mirror_rl_button, 1, 1)
-        layout.addLayout(buttons)
-        self._items = []
-        self._set_enabled(False)
+        return buttons
 
     def _box(self, lo, hi, decimals, slot):
         box = QtWidgets.QDoubleSpinBox()

@@ -136,7 +136,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.jobs.changed.connect(self.edit.update)
         self.view_actions = ViewActions(self, view, d, self.status)
         sb.addPermanentWidget(self.view_actions.mode_label)
-        self._build_docks()
+        self._build_docks(services)
         self.files = FileActions(d, services, lambda: self.confirm_close,
                                  lambda action: self._may_drop_changes(action),
                                  self.screenshot, self.close)
@@ -161,7 +161,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.status(note or f"Loaded {rig.name}: drag a joint sphere to pose; "
                             f"Ctrl+Z undoes")
 
-    def _build_docks(self):
+    def _build_docks(self, services):
         """Right: joints and info; bottom: the timeline."""
         self.panels = Panels(self, self.document, lambda: self.timeline.playing,
                              lambda: self.scene_view.interacting)
@@ -169,7 +169,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.addDockWidget(QtCore.Qt.RightDockWidgetArea, self.panels.joint_dock)
         self.addDockWidget(QtCore.Qt.RightDockWidgetArea, self.panels.info_dock)
         self.setCorner(QtCore.Qt.BottomRightCorner, QtCore.Qt.RightDockWidgetArea)
-        self.timeline = TimelineDock(self)
+        self.timeline = TimelineDock(self.document, services, self)
         self.addDockWidget(QtCore.Qt.BottomDockWidgetArea, self.timeline)
         self.morph_dock = MorphDock(self, self.document, self.status)   # right, under Info
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from PyQt5 import QtCore
 
 from ..editor.document import skeleton_with_moved_joint
-from .jobs import weights_in_chunks
+from ..editor.recompute import compute_weights_for
 
 __all__ = ["RestRebind"]
 
@@ -107,8 +107,9 @@ class RestRebind:
             self.status(f"Re-bind cancelled; {name} keeps its rest position")
 
         job = self.run_job(f"Re-binding after moving {name}",
-                           lambda report: weights_in_chunks(vertices, skeleton, report=report,
-                                                            faces=rig.faces),
+                           lambda report: compute_weights_for(vertices, skeleton,
+                                                              progress=report,
+                                                              faces=rig.faces),
                            done, cancelled)
         # Where the move sits in the history: undo from here cancels it.
         self.pending = (job, d.undo_stack.top, label) if job is not None else None

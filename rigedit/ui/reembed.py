@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..editor.autorig import reembed_mesh
 from .menus import make_action
 
 __all__ = ["ReembedAction", "moved_joints", "MOVED"]
@@ -109,13 +110,7 @@ class ReembedAction:
         label = f"{self.LABEL} {rig.name or 'the character'} around {len(hints)} joints"
 
         def work(progress):
-            from rigedit import autorig
-
-            progress(0.0)
-            # the mesh stands +Y up facing +Z already: no orientation to guess
-            return autorig((vertices, faces), template=template, up="y", forward="z",
-                           weights=weights, clips=clips, hints=hints,
-                           progress=lambda f, stage=None: progress(f))
+            return reembed_mesh(vertices, faces, template, weights, clips, hints, progress)
 
         return self.services.run_job(label, work,
                                      lambda new: self._done(rig, top, new, sorted(hints)))

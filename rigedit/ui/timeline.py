@@ -9,7 +9,7 @@ the dock's :attr:`~TimelineDock.keys`) and clip edits
 editor's commands (:mod:`rigedit.editor.key_commands`, :mod:`rigedit.editor.clip_commands`), one
 undo step per user action; the dock follows the document's typed events.
 
-Playback is driven by elapsed time (:class:`~rigedit.animation.playback.PlaybackClock` fed
+Playback is driven by elapsed time (:class:`~rigedit.editor.playback.PlaybackClock` fed
 with ``time.perf_counter``) from a QTimer: a slow frame skips ahead.
 """
 from __future__ import annotations
@@ -18,9 +18,8 @@ import time as _time
 
 from PyQt5 import QtCore, QtGui, QtWidgets
 
-from ..animation.interpolate import ROTATION_MODES, VECTOR_MODES
-from ..animation.playback import PlaybackClock
 from ..editor import events as ev
+from ..editor.playback import ROTATION_MODES, VECTOR_MODES, PlaybackClock
 from ..editor.timeline_keys import KeyEditor
 from .timeline_clips import ClipManager
 from .timeline_ruler import TimelineRuler
@@ -42,8 +41,7 @@ def _button(text, tip, slot, checkable=False):
 
 
 class TimelineDock(QtWidgets.QDockWidget):
-    """Timeline, playback, keys and clips for a :class:`~rigedit.ui.main_window.MainWindow`
-    (anything with a ``document`` attribute works).
+    """Timeline, playback, keys and clips of the document.
 
     Scripts and tests drive it with :meth:`play`, :meth:`pause`, :meth:`stop`,
     :meth:`set_time` and :attr:`time` (seconds), edit keys with :attr:`keys`
@@ -51,16 +49,26 @@ class TimelineDock(QtWidgets.QDockWidget):
     ``set_interpolation``) and clips with :attr:`clip_manager` (``new_clip``, ``add_clip``,
     ``rename_clip``, ``duplicate_clip``, ``delete_clip``, ``set_duration``).
 
+    Parameters
+    ----------
+    document : Document
+    services : Services
+        The dock's parent (``services.parent``) and the error display of a refused edit.
+    host : QWidget
+        The widget whose K / Shift+K shortcuts key the selection from anywhere in it, and
+        whose closing pauses playback (the window: no tick may touch a closing view).
+
     Attributes
     ----------
     keys : KeyEditor
     clip_manager : ClipManager
     """
 
-    def __init__(self, window):
-        super().__init__("Timeline", window)
+    def __init__(self, document, services, host):
+        super().__init__("Timeline", services.parent)
         self.setObjectName("timeline")
-        self.document = window.document
+        self.document = document
+        self.services = services
         self.clock = PlaybackClock()
         self.fps = 30.0
         self.clip_manager = ClipManager(self.document, self, self.pause, self.set_time,
@@ -71,8 +79,8 @@ class TimelineDock(QtWidgets.QDockWidget):
         self.timer.setTimerType(QtCore.Qt.PreciseTimer)
         self.timer.timeout.connect(self._tick)
         self._build()
-        self._shortcuts(window)
-        window.installEventFilter(self)
+        self._shortcuts(host)
+        host.installEventFilter(self)   # its Close pauses playback (eventFilter)
         self.document.listen(self._on_event)
         self._reload_clips()
 
@@ -173,11 +181,11 @@ class TimelineDock(QtWidgets.QDockWidget):
         row2.addStretch(1)
         return row2
 
-    def _shortcuts(self, window):
+    def _shortcuts(self, host):
         keys = self.keys
         for seq, slot in (("K", lambda: keys.insert_key()),
                           ("Shift+K", lambda: keys.insert_key(all_joints=True))):
-            sc = QtWidgets.QShortcut(QtGui.QKeySequence(seq), window)
+            sc = QtWidgets.QShortcut(QtGui.QKeySequence(seq), host)
             sc.activated.connect(slot)
         for seq, slot in ((QtGui.QKeySequence.Delete, lambda: keys.delete_key()),
                           (QtGui.QKeySequence.Copy, lambda: keys.copy_keys()),
@@ -336,8 +344,4 @@ class TimelineDock(QtWidgets.QDockWidget):
             self.auto_box.setChecked(self.keys.auto_key)
 
     def _error(self, message):
-        win = self.parent()
-        if hasattr(win, "error"):
-            win.error("Timeline", message)
-        else:
-            QtWidgets.QMessageBox.warning(self, "Timeline", message)
+        self.services.error("Timeline", message)

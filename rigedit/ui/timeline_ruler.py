@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
-from ..animation.playback import snap_to_frame
+from ..editor.playback import snap_to_frame
 
 __all__ = ["TimelineRuler"]
 

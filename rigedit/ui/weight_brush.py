@@ -20,14 +20,12 @@ from __future__ import annotations
 import numpy as np
 from PyQt5 import QtWidgets
 
-from ..binding.weight_paint import mirror_vertices, vertex_adjacency
 from ..editor import events as ev
+from ..editor.weight_stroke import BrushTables, WeightStroke
 from ..render.brush_circle import BrushCircle
 from ..render.observers import add_mouse_observers
 from ..render.surface_pick import SurfacePicker, nearest_vertex, world_radius
 from .brush_panel import BrushPanel
-from ..editor.mirror import side_axis
-from ..editor.weight_stroke import WeightStroke
 
 __all__ = ["BrushPanel", "WeightBrush"]
 
@@ -81,7 +79,7 @@ class WeightBrush:
         self.enabled = False
         self.locked = set()
         self.stroke = None
-        self._cache = {}
+        self.tables = BrushTables(document)
         self._click = None  # (x, y, vertex) of a press that may become a plain click
         self.circle = BrushCircle()
         self._picker = SurfacePicker()
@@ -129,7 +127,7 @@ class WeightBrush:
         if not overlay.HasViewProp(self.circle.actor):
             overlay.AddViewProp(self.circle.actor)
         self._picker.reset()
-        self._cache = {}
+        self.tables.clear()
 
     def _on_event(self, event):
         if isinstance(event, ev.RigReplaced):
@@ -277,31 +275,16 @@ class WeightBrush:
         self.request_render()
 
     # ------------------------------------------------------------------ painting
-    def _rig_cache(self, key, make):
-        rig = self.document.rig
-        if self._cache.get("rig") is not rig:
-            self._cache = {"rig": rig}
-        if key not in self._cache:
-            self._cache[key] = make(rig)
-        return self._cache[key]
-
     def dab(self, point, x, y):
         """Paint one dab of the stroke at surface ``point`` (mouse at display (x, y))."""
         s = self.stroke
         p = self.panel
-        d = self.document
         radius = self.world_radius(point, p.radius_box.value())
         self._show_circle(x, y, True)
         if not radius > 0:
             return
-        adjacency = mirror = None
-        if p.mode == "smooth":
-            adjacency = self._rig_cache(
-                "adjacency", lambda rig: vertex_adjacency(rig.faces, len(rig.vertices)))
-        if p.mirror_box.isChecked():
-            axis = side_axis(d.skeleton, d.mirror)
-            mirror = self._rig_cache(("mirror", axis),
-                                     lambda rig: mirror_vertices(rig.vertices, axis))
+        adjacency = self.tables.adjacency() if p.mode == "smooth" else None
+        mirror = self.tables.mirror() if p.mirror_box.isChecked() else None
         if not s.dab(np.asarray(self.view.scene.mesh.points), point, radius, p.mode,
                      p.strength_box.value(), p.value_box.value(), self.locked, adjacency,
                      mirror):

@@ -26,8 +26,8 @@ def setup(monkeypatch):
     doc = Document(demo_rig())
     binding = doc.rig.binding
     # the worker's weights: the current ones (the maths is tested elsewhere)
-    monkeypatch.setattr(rebind_module, "weights_in_chunks",
-                        lambda vertices, skeleton, report=None, faces=None:
+    monkeypatch.setattr(rebind_module, "compute_weights_for",
+                        lambda vertices, skeleton, progress=None, faces=None:
                         (binding.indices.copy(), binding.weights.copy()))
     jobs, log = [], {"status": [], "refresh": 0, "undo_changed": 0}
     held = [False]

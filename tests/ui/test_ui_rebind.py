@@ -17,18 +17,19 @@ from ui_window_fixture import limb_joint  # noqa: E402
 def gate(monkeypatch):
     """Holds every re-bind and weights job open until ``gate.set()`` (cancel still works
     meanwhile)."""
-    from rigedit.ui import file_actions, rebind
+    from rigedit.editor import recompute
+    from rigedit.ui import rebind
 
     event = threading.Event()
-    real = rebind.weights_in_chunks
+    real = recompute.compute_weights_for
 
-    def slow(vertices, skeleton, *args, report=None, **kw):
+    def slow(vertices, skeleton, *args, progress=None, **kw):
         while not event.wait(0.01):
-            report(0.0)  # raises Cancelled once the user cancelled
-        return real(vertices, skeleton, *args, report=report, **kw)
+            progress(0.0)  # raises Cancelled once the user cancelled
+        return real(vertices, skeleton, *args, progress=progress, **kw)
 
-    monkeypatch.setattr(rebind, "weights_in_chunks", slow)
-    monkeypatch.setattr(file_actions, "weights_in_chunks", slow)
+    monkeypatch.setattr(rebind, "compute_weights_for", slow)       # edit-mode re-binds
+    monkeypatch.setattr(recompute, "compute_weights_for", slow)    # File > Recompute weights
     yield event
     event.set()
 

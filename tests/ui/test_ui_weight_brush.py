@@ -1,15 +1,13 @@
 """The weight brush through real mouse events on the editor's 3D view (under Xvfb): a stroke
 paints the selected joint only within the brush radius, rows sum to 1, one undo step restores
 the weights exactly, and a Ctrl+click shows a vertex's influences in the info panel."""
-from testpaths import TESTS
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-pytest.importorskip("pytestqt")
-sys.path.insert(0, str(TESTS))
+import pytestqt  # noqa: F401 - needed: without pytest-qt these fail, never skip
+
+pytestmark = pytest.mark.ui
+
 from ui_window_fixture import demo_window, rig_template, window  # noqa: E402,F401
 
 from rigedit.binding.weight_paint import joint_column  # noqa: E402

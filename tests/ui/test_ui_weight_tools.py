@@ -1,14 +1,12 @@
 """Editor toggles of issue 10: DQS/LBS in the View menu, Recompute weights with a chosen
 method, and the joint panel's per-joint "deforms" flag (real window under Xvfb)."""
-from testpaths import TESTS
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-pytest.importorskip("pytestqt")
-sys.path.insert(0, str(TESTS))
+import pytestqt  # noqa: F401 - needed: without pytest-qt these fail, never skip
+
+pytestmark = pytest.mark.ui
+
 from ui_window_fixture import demo_window, menu_action  # noqa: E402,F401
 
 from rigedit.binding.weights import compute_weights  # noqa: E402
