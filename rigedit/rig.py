@@ -208,7 +208,7 @@ class Rig:
         return float(hi[axis] - lo[axis]) or float(np.linalg.norm(hi - lo)) or 1.0
 
     def save(self, path, clips=None):
-        """Write the rig; the format follows ``path`` (a folder, .glb, .gltf or .bvh), see
+        """Write the rig; the format follows ``path`` (a folder, .glb, .gltf, .fbx or .bvh), see
         :func:`rigedit.io.save.save_rig`."""
         # imported here, not at the top: the registry loads every format's modules (glTF's
         # pygltflib among them), about 0.1 s that ``import rigedit`` need not pay

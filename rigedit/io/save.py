@@ -3,6 +3,7 @@
 ==========================  =========================================================
 no suffix (a folder)        a rig folder (:func:`rigedit.io.rig_folder.save_rig_folder`)
 ``.glb`` / ``.gltf``        glTF 2.0 (:func:`rigedit.io.gltf_write.save_gltf`)
+``.fbx``                    binary FBX 7.4 in centimetres (:func:`rigedit.io.fbx_write.write_fbx`)
 ``.bvh``                    BVH: the skeleton and one clip (:func:`rigedit.io.bvh.save_bvh`)
 ==========================  =========================================================
 """
@@ -25,10 +26,11 @@ def save_rig(rig, path, clips=None):
     rig : RigData or Rig
         The rig's data (:class:`~rigedit.io.data.RigData`; a Rig gives its ``data()``).
     path : str or os.PathLike
-        A folder (no suffix, or an existing directory), ``.glb``, ``.gltf`` or ``.bvh``.
+        A folder (no suffix, or an existing directory), ``.glb``, ``.gltf``, ``.fbx`` or
+        ``.bvh``.
     clips : list[str], optional
         Names of the clips to write (all when omitted; BVH holds one, the first named or the
-        rig's first clip). Only glTF and BVH take a selection; a folder gets every clip.
+        rig's first clip). Only glTF, FBX and BVH take a selection; a folder gets every clip.
 
     Raises
     ------
