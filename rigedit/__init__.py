@@ -21,12 +21,14 @@ __all__ = ["load_rig", "save_rig", "retarget", "autorig", "resolve_rig_path", "B
 __version__ = "0.1.0"
 
 
-def load_rig(rig=None, weights_method=None, scale=None):
+def load_rig(rig=None, weights_method=None, scale=None, allow_outside_uris=False):
     """Load a rig: a bundled name (``quadruped``, the default, or ``humanoid``), a rig folder,
     a ``.glb``/``.gltf`` file or a ``.bvh`` file. The file is read into plain data
     (:func:`rigedit.io.load.read_rig`), then :meth:`Rig.from_data` builds the rig, computing
     the weights with ``weights_method`` where the source has none (a
     ``WeightsComputedWarning`` says so). ``scale``: metres per unit, BVH only.
+    ``allow_outside_uris``: let a glTF read buffers and images outside its folder (off by
+    default: a shared file could otherwise read any file of the machine).
 
     Raises
     ------
@@ -35,7 +37,8 @@ def load_rig(rig=None, weights_method=None, scale=None):
     """
     from .io.load import read_rig
 
-    return Rig.from_data(read_rig(rig, scale=scale), weights_method=weights_method)
+    return Rig.from_data(read_rig(rig, scale=scale, allow_outside_uris=allow_outside_uris),
+                         weights_method=weights_method)
 
 
 def retarget(source_rig, source_clip, target_rig, map=None, name=None, clean_feet=True,

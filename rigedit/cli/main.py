@@ -23,13 +23,17 @@ class UsageError(Exception):
     """Bad input that is not about a file (an unknown clip, a bad option value)."""
 
 
+#: Options of every rig the command loads (set by :func:`main` from ``--allow-outside-uris``).
+_LOAD_OPTIONS = {}
+
+
 def _load(rig_arg, method=None, scale=None):
     import rigedit
 
     from .output import warning_lines
 
     with warning_lines():
-        return rigedit.load_rig(rig_arg, weights_method=method, scale=scale)
+        return rigedit.load_rig(rig_arg, weights_method=method, scale=scale, **_LOAD_OPTIONS)
 
 
 def cmd_info(args):
@@ -117,8 +121,13 @@ def check_options(args):
 
 def cmd_render(args):
     from .output import check_interrupted, deferred
-    from ..render.recorder import frame_times, record_clip
 
+    # A signal raised while VTK's extension modules initialise can leave them half made and
+    # crash the interpreter's exit (SIGSEGV): the import only records it, and it is raised
+    # once the import is done.
+    with deferred():
+        from ..render.recorder import frame_times, record_clip
+    check_interrupted()
     size = _parse_size(args.size)  # fps, duration and size were checked by check_options
     rig = _load(args.rig, scale=args.scale)
     if args.clip not in rig.clips:
@@ -184,8 +193,12 @@ def cmd_autorig(args):
 
 
 def _scale_option(s):
+    """The options of the rigs a command reads: ``--scale`` and ``--allow-outside-uris``."""
     s.add_argument("--scale", type=float, default=None, metavar="M",
                    help="metres per file unit of a .bvh RIG (default: guessed from its height)")
+    s.add_argument("--allow-outside-uris", action="store_true",
+                   help="let a .gltf read buffers and images outside its folder (absolute "
+                        "paths, '..', file:); off by default")
 
 
 def build_parser():
@@ -289,6 +302,9 @@ def main(argv=None):
 
     parser = build_parser()
     args = parser.parse_args(argv)
+    _LOAD_OPTIONS.clear()
+    if getattr(args, "allow_outside_uris", False):
+        _LOAD_OPTIONS["allow_outside_uris"] = True
     try:
         with interruptible():
             check_options(args)

@@ -17,7 +17,7 @@ from pathlib import Path
 from ..errors import RigFileError, RigWriteError
 
 __all__ = ["atomic_write", "write_json", "temp_beside", "check_output_folder",
-           "fsync_folder", "naming_target", "write_error", "writing"]
+           "fsync_folder", "naming_target", "write_error", "writing", "remove_stale_temps"]
 
 def write_error(exc, path):
     """``exc`` (an ``OSError`` of a write) as the :class:`RigWriteError` naming ``path``, the
@@ -74,14 +74,60 @@ def naming_target(exc, tmp, path):
     return exc
 
 
-def temp_beside(path, suffix=None):
+def _pid_prefix(path, pid):
+    return f".{path.name}.pid{pid}-"
+
+
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:   # another user's process: alive
+        return True
+    return True
+
+
+def remove_stale_temps(path, suffix=None):
+    """Delete the temporary files that :func:`temp_beside` (``tagged=True``) made for
+    ``path`` in processes that are gone (killed with SIGKILL before their clean-up ran).
+    Those of running processes, and any other file, are left alone.
+
+    Returns
+    -------
+    list[Path]
+        The files removed.
+    """
+    path = Path(path)
+    removed = []
+    head = f".{path.name}.pid"
+    try:
+        entries = list(os.scandir(path.parent))
+    except OSError:
+        return removed
+    for entry in entries:
+        name = entry.name
+        if not (name.startswith(head) and name.endswith(suffix or ".tmp")):
+            continue
+        pid = name[len(head):].split("-", 1)[0]
+        if pid.isascii() and pid.isdigit() and int(pid) != os.getpid() \
+                and not _alive(int(pid)) and entry.is_file(follow_symlinks=False):
+            with contextlib.suppress(OSError):
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+    return removed
+
+
+def temp_beside(path, suffix=None, tagged=False):
     """Create an empty temporary file next to ``path`` (same folder, so a rename is atomic)
     with the permissions a new file would get (``mkstemp`` makes it 0600), or the target's
-    own when it exists. Returns ``(fd, tmp_path)``."""
+    own when it exists. Returns ``(fd, tmp_path)``. ``tagged``: the name carries this
+    process's id, so that a later run can tell a stale one (:func:`remove_stale_temps`)."""
     path = Path(path)
     check_output_folder(path)
+    prefix = _pid_prefix(path, os.getpid()) if tagged else f".{path.name}."
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or ".tmp",
+        fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix or ".tmp",
                                    dir=path.parent)
     except OSError as exc:  # say which file could not be written, not the temporary name
         raise write_error(exc, path) from None

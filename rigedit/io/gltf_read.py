@@ -236,12 +236,15 @@ def _notes(skeleton, used, smap, helpers, rigid, carrier):
                                                     if static else ""))
     return notes
 
-def read_gltf(path):
+def read_gltf(path, allow_outside_uris=False):
     """Read a skinned glTF 2.0 file (``.gltf`` or ``.glb``).
 
     Parameters
     ----------
     path : str or Path
+    allow_outside_uris : bool
+        Read buffers and images outside the file's folder (see
+        :class:`~rigedit.io.gltf_data.GltfData`); off by default.
 
     Returns
     -------
@@ -256,7 +259,7 @@ def read_gltf(path):
         view out of range, a skin without joints, a joint index beyond the skin, NaN in
         positions or matrices, an extension the file requires that rigedit lacks.
     """
-    data = GltfData(path)
+    data = GltfData(path, allow_outside_uris=allow_outside_uris)
     try:
         return _read(data)
     except RigFileError:

@@ -24,7 +24,7 @@ def rig_kind(path):
     return format_of(path).name
 
 
-def read_rig(rig=None, scale=None):
+def read_rig(rig=None, scale=None, allow_outside_uris=False):
     """Read a rig from a bundled name, a rig folder, a glTF/GLB file or a BVH file.
 
     Parameters
@@ -34,6 +34,9 @@ def read_rig(rig=None, scale=None):
     scale : float, optional
         Metres per file unit for BVH files (BVH has no units; guessed from the figure's
         height when omitted). Other formats state their units, so a scale there is refused.
+    allow_outside_uris : bool
+        Let a glTF read buffers and images outside its folder (absolute paths, ``..``,
+        ``file:``); off by default, ignored by formats without URIs.
 
     Returns
     -------
@@ -53,12 +56,14 @@ def read_rig(rig=None, scale=None):
     if set(options) - set(fmt.options):
         raise RigFileError(path, f"expected --scale/scale= only with a .bvh file (BVH has no "
                                  f"units), got it with a {fmt.name}")
+    if allow_outside_uris and "allow_outside_uris" in fmt.options:   # a permission, not a need
+        options["allow_outside_uris"] = True
     if fmt.suffixes and what_is(path) != "a file":
         raise RigFileError(path, f"expected a file, got {what_is(path) or 'nothing (not found)'}")
     return fmt.read(path, **options)
 
 
-def load_rig(rig=None, weights_method=None, scale=None):
+def load_rig(rig=None, weights_method=None, scale=None, allow_outside_uris=False):
     """Load a rig (:func:`read_rig`, then ``Rig.from_data``, which computes the weights of a
     rig folder without a weights file with ``weights_method``).
 
@@ -66,4 +71,5 @@ def load_rig(rig=None, weights_method=None, scale=None):
     -------
     Rig
     """
-    return build_rig(read_rig(rig, scale=scale), weights_method=weights_method)
+    return build_rig(read_rig(rig, scale=scale, allow_outside_uris=allow_outside_uris),
+                     weights_method=weights_method)

@@ -18,7 +18,7 @@ from pathlib import Path
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkUnsignedCharArray
 
-from ..io.atomic import naming_target, temp_beside
+from ..io.atomic import remove_stale_temps, temp_beside, write_error
 from ..progress import Cancelled
 
 __all__ = ["VideoWriter", "ThreadedWriter", "FrameReader", "RecordingCancelled"]
@@ -39,7 +39,10 @@ class VideoWriter:
         self.path = Path(path)
         self.fps = fps
         self.gif = self.path.suffix.lower() == ".gif"
-        fd, tmp = temp_beside(self.path, suffix=self.path.suffix)
+        # a render killed with SIGKILL could not remove its temporary video: the next one to
+        # the same file does (the names carry the pid; those of live processes stay)
+        remove_stale_temps(self.path, suffix=self.path.suffix)
+        fd, tmp = temp_beside(self.path, suffix=self.path.suffix, tagged=True)
         os.close(fd)
         self.tmp = Path(tmp)
         self.frames = []
@@ -87,7 +90,9 @@ class VideoWriter:
                 self.writer.close()
             os.replace(self.tmp, self.path)
         except OSError as exc:   # name the user's file, not the temporary one
-            raise naming_target(exc, self.tmp, self.path) from None
+            with contextlib.suppress(OSError):
+                self.tmp.unlink()
+            raise write_error(exc, self.path) from None
 
     def abort(self):
         with contextlib.suppress(Exception):
