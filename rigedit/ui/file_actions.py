@@ -225,11 +225,13 @@ class FileActions:
             f"Exported the skeleton to {path}")
 
     def export(self, path=None):
-        """Export the rig as glTF (.glb/.gltf, every clip) or BVH (the skeleton and the
-        current clip); the format follows the extension."""
+        """Export the rig as glTF (.glb/.gltf, every clip), FBX (.fbx, every clip, in
+        centimetres) or BVH (the skeleton and the current clip); the format follows the
+        extension."""
         rig = self.doc.rig
         path = path or self._ask_save("Export", f"{rig.name}.glb",
-                                      "glTF binary (*.glb);;glTF (*.gltf);;BVH (*.bvh)")
+                                      "glTF binary (*.glb);;glTF (*.gltf);;FBX (*.fbx);;"
+                                      "BVH (*.bvh)")
         if not path:
             return False
         return self._attempt("Export", lambda: files.export_rig(self.doc, path),
