@@ -14,8 +14,8 @@ quaternions (nor a spline), so a track is sampled rather than copied: at its own
 every frame of the scene's rate (:data:`FPS`), so that rigedit and the file agree exactly at
 every frame, and rotations also wherever the angles' straight line strays more than
 :data:`EULER_TOLERANCE` from the track between keys (:func:`rotation_keys`), so that they
-agree closely between. A translation or scale track of ``linear`` or ``step`` keys
-is the same curve in FBX and is written at its keys only. Rotations are Euler XYZ degrees
+agree closely between. A ``step`` track, and a translation or scale track of ``linear``
+keys, is the same curve in FBX and is written at its keys only. Rotations are Euler XYZ degrees
 (matrix Rz·Ry·Rx, FBX's ``eEulerXYZ``) made continuous from key to key (each key the
 equivalent triple nearest the one before), since FBX interpolates the numbers as written.
 """
@@ -28,8 +28,7 @@ from .fbx_document import TICKS_PER_SECOND, properties70, ticks
 from .fbx_write_skin import euler_degrees
 
 __all__ = ["write_clips", "continuous_euler", "sample_times", "rotation_keys",
-           "sample_rotations", "FPS",
-           "EULER_TOLERANCE", "MAX_HALVINGS"]
+           "sample_rotations", "FPS", "EULER_TOLERANCE", "MAX_HALVINGS"]
 
 #: The scene's frame rate: every track is keyed at least at each of its frames.
 FPS = 30.0
@@ -77,7 +76,9 @@ def sample_times(track, duration, fps=FPS):
     """(N,) times a track is written at, seconds: its keys within ``[0, duration]``, both
     ends, and every frame when FBX's linear curve is not the track's own (rotations, splines);
     no two in the same tick."""
-    exact = track.channel != "rotation" and track.interpolation in ("linear", "step")
+    # FBX's constant keys are a step track exactly, its linear keys a linear vector track
+    exact = track.interpolation == "step" or (track.channel != "rotation"
+                                              and track.interpolation == "linear")
     return _times(track.times, duration, exact, fps)
 
 
@@ -153,7 +154,8 @@ def rotation_keys(track, duration, tolerance=EULER_TOLERANCE):
     """
     t = sample_times(track, duration)
     q = sample_rotations(track, t)
-    check = np.ones(max(len(t) - 1, 0), dtype=bool)
+    # a step track is written with constant keys: nothing in between to follow
+    check = np.full(max(len(t) - 1, 0), track.interpolation != "step")
     for _ in range(MAX_HALVINGS):
         idx = np.flatnonzero(check)
         if not len(idx):

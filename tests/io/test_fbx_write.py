@@ -179,6 +179,10 @@ def test_sample_times():
     assert np.all(np.isin(np.arange(31) / 30, t)) and 0.05 in t
     vec = Track("translation", [0.05, 0.5, 2.0], np.zeros((3, 3)))
     assert list(sample_times(vec, 1.0)) == [0.0, 0.05, 0.5, 1.0]
+    # a step rotation is constant keys in FBX: its own keys only, no refinement at the jump
+    step = Track("rotation", [0.05, 0.5], [[0, 0, 0, 1], [0, 0.6, 0, 0.8]], "step")
+    times, _ = rotation_keys(step, 1.0)
+    assert list(times) == [0.0, 0.05, 0.5, 1.0]
 
 
 def test_binary_container_layout():
