@@ -29,6 +29,7 @@ from .rig_save import (STAGING, folder_lock, recover_interrupted_save, remember_
                        save_rig_folder_atomic)
 from .paths import list_folder, os_problem, what_is
 from .skeleton_json import UP_AXES, load_skeleton
+from .morphs_npz import load_morphs
 from .weights_npz import load_weights, weights_vertex_count
 
 __all__ = ["read_rig_folder", "write_rig_folder", "load_rig_folder", "save_rig_folder",
@@ -55,7 +56,7 @@ def read_manifest(path):
     if not isinstance(manifest, dict):
         raise RigFileError(path, f"expected a JSON object, got {type(manifest).__name__}")
     out = {}
-    for key in ("mesh", "skeleton", "weights"):
+    for key in ("mesh", "skeleton", "weights", "morphs"):
         if manifest.get(key) is not None:
             out[key] = relative_path(path, manifest[key], repr(key))
     if "mesh" in manifest and manifest["mesh"] is None:
@@ -116,8 +117,13 @@ def find_rig_files(folder):
         if not anim_dir.is_dir():
             raise RigFileError(anim_dir, "expected a folder of clip files, got a file")
         animations = [p for p in list_folder(anim_dir) if p.suffix.lower() == ".json"]
+    morphs = folder / manifest["morphs"] if "morphs" in manifest else None
+    if morphs is not None and not _exists(morphs):
+        raise RigFileError(folder / "rig.json", f"expected the morph targets it names "
+                                                f"({manifest['morphs']}), got no such file")
     return {"meshes": meshes, "skeleton": skeleton,
             "weights": weights if meshes and _exists(weights) else None,  # none without a mesh
+            "morphs": morphs if meshes else None,
             "animations": animations, "manifest": manifest}
 
 
@@ -186,7 +192,8 @@ def _read(folder):
         clips[clip.name], sources[clip.name] = clip, path
     if clip_change is not None:   # rigedit's formats: skeleton and clips change together
         skeleton, clips = change_axes(skeleton, clips, clip_change)
-    data = RigData(skeleton, vertices, faces, indices, weights, clips,
+    morphs = None if files["morphs"] is None else load_morphs(files["morphs"], len(vertices))
+    data = RigData(skeleton, vertices, faces, indices, weights, clips, morphs=morphs,
                    name=files["manifest"].get("name", folder.resolve().name), up=up,
                    meta=RigMeta(source=folder, format="folder"))
     remember_clip_files(data, sources)   # a later save replaces exactly these

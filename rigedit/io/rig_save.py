@@ -39,8 +39,11 @@ import signal
 import threading
 from pathlib import Path, PurePosixPath
 
+import numpy as np
+
 from ..animation.clip_names import check_clip_name
 from ..errors import RigFileError, RigWriteError
+from ..model.morph import MorphTargets
 from .atomic import check_output_folder, fsync_folder, write_error, write_json
 from .bundled import is_bundled
 from .clip_files import (ANIMATIONS, clip_entry, loaded_clip_files, plan_clip_files,
@@ -49,6 +52,7 @@ from .clip_json import save_clip
 from .data import as_rig_data
 from .mesh import save_obj
 from .skeleton_json import save_skeleton
+from .morphs_npz import save_morphs
 from .weights_npz import save_weights
 
 __all__ = ["save_rig_folder_atomic", "recover_interrupted_save", "remember_clip_files",
@@ -143,6 +147,33 @@ def _named(exc, folder):
     return exc
 
 
+def _referenced(rig):
+    """The rig's mesh, weights and morph targets without the vertices no face uses.
+
+    The mesh reader keeps only referenced vertices (stray points would take weights and widen
+    bounding boxes), so a folder written with them would not load back: its weights would be
+    for more vertices than its mesh has (a glTF primitive with unused vertices did this).
+
+    Returns
+    -------
+    vertices (V', 3), faces (F, 3), indices (V', K), weights (V', K), morphs or None
+    """
+    vertices, faces = np.asarray(rig.vertices), np.asarray(rig.faces)
+    indices, weights = np.asarray(rig.indices), np.asarray(rig.weights)
+    morphs = getattr(rig, "morphs", None)
+    used = np.zeros(len(vertices), dtype=bool)
+    used[faces.ravel()] = True
+    if used.all():
+        return vertices, faces, indices, weights, morphs
+    remap = np.cumsum(used) - 1
+    if morphs is not None:
+        morphs = MorphTargets(morphs.names, morphs.deltas[:, used],
+                              normal_deltas=None if morphs.normal_deltas is None
+                              else morphs.normal_deltas[:, used],
+                              default_weights=morphs.default_weights)
+    return vertices[used], remap[faces], indices[used], weights[used], morphs
+
+
 def _save(folder, rig, names, mesh_name):
     files, stale = plan_clip_files(folder, rig, names)
 
@@ -152,11 +183,15 @@ def _save(folder, rig, names, mesh_name):
         (stage / ANIMATIONS).mkdir(parents=True)
         # a rig without a mesh (a BVH skeleton) has no mesh or weights file: "mesh": null
         meshless = len(rig.vertices) == 0
+        morphs = None
         if not meshless:
-            save_obj(stage / mesh_name, rig.vertices, rig.faces,
-                     header=f"rigedit rig {rig.name}")
-            save_weights(stage / "weights.npz", rig.indices, rig.weights,
-                         rig.skeleton.names)
+            vertices, faces, indices, weights, morphs = _referenced(rig)
+            save_obj(stage / mesh_name, vertices, faces, header=f"rigedit rig {rig.name}")
+            save_weights(stage / "weights.npz", indices, weights, rig.skeleton.names)
+        # morph targets (a glTF's or FBX's shapes) go with the mesh; their weight tracks
+        # are in the clips' files
+        if morphs is not None:
+            save_morphs(stage / "morphs.npz", morphs)
         save_skeleton(stage / "skeleton.json", rig.skeleton, up=rig.up)
         for clip in rig.clips.values():
             save_clip(stage / ANIMATIONS / files[clip.name], clip)
@@ -166,11 +201,14 @@ def _save(folder, rig, names, mesh_name):
                     "clips": clip_paths}
         if meshless:
             del manifest["weights"]
+        if morphs is not None:
+            manifest["morphs"] = "morphs.npz"
         write_json(stage / "rig.json", manifest)
         fsync_folder(stage / ANIMATIONS)
         fsync_folder(stage)
         journal = {"format": "rigedit.save-journal", "version": 1,
                    "replace": [*([] if meshless else [mesh_name, "weights.npz"]),
+                               *([] if morphs is None else ["morphs.npz"]),
                                "skeleton.json", *clip_paths.values(), "rig.json"],
                    "delete": [f"{ANIMATIONS}/{f}" for f in stale]}
     except BaseException:
