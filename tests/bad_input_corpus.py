@@ -267,7 +267,8 @@ GARBAGE = bytes(np.random.default_rng(8).integers(0, 256, 4000, dtype=np.uint8))
 # ---------------------------------------------------------------------------- rig.json
 case("rigjson_mesh_list", "rig.json")(rig_json_edit("mesh", ["mesh.obj"]))
 case("rigjson_mesh_number", "rig.json")(rig_json_edit("mesh", 3))
-case("rigjson_mesh_null", None)(rig_json_edit("mesh", None))
+# null is a rig without a mesh: refused where the folder has weights for one (issue 19)
+case("rigjson_mesh_null", "rig.json")(rig_json_edit("mesh", None))
 case("rigjson_mesh_empty", "rig.json")(rig_json_edit("mesh", ""))
 case("rigjson_skeleton_bool", "rig.json")(rig_json_edit("skeleton", True))
 case("rigjson_weights_object", "rig.json")(rig_json_edit("weights", {}))
@@ -314,6 +315,20 @@ case("sk_deform_zero", "skeleton.json")(joint_edit("deform", 0))
 case("sk_name_list", "skeleton.json")(joint_edit("name", ["j1"]))
 case("sk_name_nul", "skeleton.json")(joint_edit("name", "j\u00001"))
 case("sk_name_newline", "skeleton.json")(joint_edit("name", "j\n1"))
+# issue 19: the rig-folder fuzz corpus's leftovers
+case("sk_translation_null", "skeleton.json")(joint_edit("translation", None))
+case("sk_rotation_null", "skeleton.json")(joint_edit("rotation", None))
+case("sk_scale_null", "skeleton.json")(joint_edit("scale", None))
+case("sk_none_deforms", "skeleton.json")(lambda f: edit_json(sk(f), lambda d: [
+    j.update(deform=False) for j in d["joints"]]))
+
+
+@case("sk_name_tab", None)
+def _tab_name(folder):
+    """A joint name with a tab: the format allows it (the weights are computed again, the
+    weights file naming the old name being removed)."""
+    edit_json(sk(folder), lambda d: d["joints"][2].update(name="j\t2"))
+    (folder / "weights.npz").unlink()
 case("sk_parent_list", "skeleton.json")(joint_edit("parent", ["j0"]))
 case("sk_parent_number", "skeleton.json")(joint_edit("parent", 0))
 case("sk_parent_object", "skeleton.json")(joint_edit("parent", {"name": "j0"}))
@@ -371,6 +386,7 @@ case("clip_times_bools", A)(track_edit("times", [False, True, 2]))
 case("clip_times_huge_int", A)(track_edit("times", raw=f"[0, 0.5, {HUGE_INT}]"))
 case("clip_times_long_int", A)(track_edit("times", raw=f"[0, 0.5, {LONG_INT}]"))
 case("clip_times_1e300", A)(track_edit("times", [0, 0.5, 1e300]))
+case("clip_times_negative", A)(track_edit("times", [-0.5, 0.5, 1]))
 case("clip_values_width", A)(track_edit("values", [[0, 0, 0], [0, 0, 0], [0, 0, 0]]))
 case("clip_values_nan", A)(
     track_edit("values", raw="[[0, 0, 0, 1], [0, 0, NaN, 1], [0, 0, 0, 1]]"))

@@ -114,6 +114,8 @@ def _load_rigedit(path, data, skeleton):
         where = f"track {i} ({joint!r} {channel})"
         times = numbers(path, require(path, e, "times", list, f" in track {i}"),
                         "'times'", bound=MAX_SECONDS, where=where)
+        if len(times) and times.min() < 0:   # a clip starts at 0 (as morph tracks do)
+            raise RigFileError(path, f"{where}: expected key times >= 0, got {times.min():g}")
         values = numbers(path, require(path, e, "values", list, f" in track {i}"),
                          "'values'", width=CHANNELS[channel], count=len(times), where=where)
         mode = optional(e, "interpolation", None)

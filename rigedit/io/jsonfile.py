@@ -174,14 +174,19 @@ def vector(path, value, n, what, bound=MAX_MAGNITUDE, where=""):
     return numbers(path, value, what, bound=bound, count=n, where=where)
 
 
-def name(path, value, what, where=""):
-    """A non-empty string without control characters (no NUL, no newline), of sane length."""
+def name(path, value, what, where="", controls=False):
+    """A non-empty string without control characters (no NUL, no newline), of sane length.
+    ``controls``: other control characters (a tab) are allowed, only NUL and line breaks are
+    not (joint names: the format allows any JSON string and exporters write tabs, but a name
+    must stay on the one line of a message or a BVH file)."""
     if not isinstance(value, str) or not value:
         raise _fail(path, where, f"expected {what} to be a non-empty name, got {_kind(value)}")
     if len(value) > MAX_NAME_CHARS:
         raise _fail(path, where, f"expected {what} of at most {MAX_NAME_CHARS} characters, "
                                  f"got {len(value)}")
-    bad = next((c for c in value if ord(c) < 32 or ord(c) == 127), None)
+    bad = next((c for c in value if c in "\0\r\n" or (not controls and (ord(c) < 32 or
+                                                                          ord(c) == 127))),
+               None)
     if bad is not None:
         raise _fail(path, where, f"expected {what} without control characters, got "
                                  f"{_short(value)}")

@@ -60,6 +60,9 @@ def read_manifest(path):
         if manifest.get(key) is not None:
             out[key] = relative_path(path, manifest[key], repr(key))
     if "mesh" in manifest and manifest["mesh"] is None:
+        if manifest.get("weights") is not None or _exists(path.parent / "weights.npz"):
+            raise RigFileError(path, "expected 'mesh' to name the mesh file, got null in a "
+                                     "folder with skin weights (null is a rig without a mesh)")
         out["mesh"] = None   # a rig without a mesh
 
     if manifest.get("name") is not None:

@@ -44,7 +44,7 @@ def _parent(path, joint, value):
     # An empty string marks a root in some exports, as null does.
     if value is None or (isinstance(value, str) and not value):
         return None
-    return name(path, value, "'parent'", where=f"joint {joint!r}")
+    return name(path, value, "'parent'", where=f"joint {joint!r}", controls=True)
 
 
 def _checked(path, build):
@@ -138,19 +138,26 @@ def _bind_pose(t, r, s, parents, names, binds, order):
     return np.stack([rest[i] if binds[k] is None else binds[k] for i, k in enumerate(order)])
 
 
+def _present(obj, key, default):
+    """``obj[key]``, or ``default`` when the key is absent; a null stays null (an error for
+    the checker: a joint whose translation is null is broken, not at the origin)."""
+    return obj[key] if key in obj else default
+
+
 def _load_rigedit(path, data):
     joints = require(path, data, "joints", list)
     names, parents, t, r, s, tails, deform, binds = [], [], [], [], [], [], [], []
     for i, j in enumerate(joints):
-        joint = name(path, require(path, j, "name", str, f" in joint {i}"), "'name'", where=f"joint {i}")
+        joint = name(path, require(path, j, "name", str, f" in joint {i}"), "'name'",
+                     where=f"joint {i}", controls=True)
         names.append(joint)
         parents.append(_parent(path, joint, j.get("parent")))
-        t.append(_vec(path, joint, "translation", optional(j, "translation", [0, 0, 0]), 3))
-        r.append(_vec(path, joint, "rotation", optional(j, "rotation", [0, 0, 0, 1]), 4))
+        t.append(_vec(path, joint, "translation", _present(j, "translation", [0, 0, 0]), 3))
+        r.append(_vec(path, joint, "rotation", _present(j, "rotation", [0, 0, 0, 1]), 4))
         if np.linalg.norm(r[-1]) < 1e-6:
             raise RigFileError(path, f"joint {joint!r}: expected 'rotation' to be a unit "
                                      f"quaternion (x, y, z, w), got {r[-1].tolist()}")
-        s.append(_vec(path, joint, "scale", optional(j, "scale", [1, 1, 1]), 3))
+        s.append(_vec(path, joint, "scale", _present(j, "scale", [1, 1, 1]), 3))
         if np.any(np.abs(s[-1]) < 1e-6):
             raise RigFileError(path, f"joint {joint!r}: expected 'scale' without a zero "
                                      f"component, got {s[-1].tolist()}")
@@ -159,6 +166,9 @@ def _load_rigedit(path, data):
         deform.append(boolean(path, optional(j, "deform", True), "'deform'",
                               where=f"joint {joint!r}"))
         binds.append(_bind_matrix(path, joint, j.get("bind_matrix")))
+    if deform and not any(deform):
+        raise RigFileError(path, "expected at least one joint that deforms, got every joint "
+                                 "'deform': false (nothing could move the mesh)")
 
     def build():
         order = topological_order(names, parents)

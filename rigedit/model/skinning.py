@@ -166,7 +166,9 @@ class SkinBinding:
         self._palette16 = np.empty((self.num_joints, 16), dtype=np.float32)
         self._dq = np.empty((self.num_joints, 8), dtype=np.float32)
         self._scale = np.empty((self.num_joints, 9), dtype=np.float32)
-        self._signs = np.empty((self.num_joints, self.num_joints), dtype=np.float32)
+        # the DQS kernel's (J, J) hemisphere table, made at the first DQS frame: a rig of
+        # 100,000 joints skinned with LBS never allocates 10^10 entries
+        self._signs = None
         self._rest_normals32 = None  # set by bind_normals
         #: The morph targets (None without) and the rest arrays with their current weights.
         self.morphs = morphs
@@ -381,6 +383,8 @@ class SkinBinding:
             dq, scale, has_scale = palette_dual_quaternions(palette, DQS_RIGID_TOL)
             self._dq[:] = dq
             self._scale[:] = scale.reshape(-1, 9)
+        if self._signs is None:
+            self._signs = np.empty((self.num_joints, self.num_joints), dtype=np.float32)
         skinning_kernels.hemisphere_signs(self._dq, self._signs)
         kernels.run("dqs", len(out), self.threads, self._rest_now, rest_normals,
                     self._indices32, self._weights32, self._dq, self._signs, self._scale,
