@@ -34,8 +34,8 @@ from ..model.skeleton import Skeleton, topological_order
 from ..model.transforms import compose_trs, decompose_trs
 from .data import RigData, RigMeta, build_rig
 from .fbx_read_anim import animated_nodes, bake_stacks, clips_of
-from .fbx_read_mesh import read_skinned_meshes
-from .fbx_read_scene import axes_text, open_scene, ufbx_module
+from .fbx_read_mesh import check_numbers, read_skinned_meshes
+from .fbx_read_scene import axes_text, open_scene, release, ufbx_module
 from .gltf_read import unique_names
 
 __all__ = ["read_fbx", "load_fbx", "FbxWarning"]
@@ -202,16 +202,18 @@ def read_fbx(path):
     scene, keep = open_scene(path)
     try:
         return _read(scene, keep, path)
-    except RigFileError:
-        raise
+    except RigFileError as exc:
+        # a new error: the old one's traceback holds the read's frames (and their ufbx
+        # objects), which must not outlive release()
+        error = RigFileError(exc.path, exc.problem)
     except (TypeError, ValueError, KeyError, IndexError, AttributeError,
             np.linalg.LinAlgError) as exc:
-        raise RigFileError(path, f"expected a valid FBX scene, got one rigedit cannot use "
-                                 f"({type(exc).__name__}: {exc})") from None
+        error = RigFileError(path, f"expected a valid FBX scene, got one rigedit cannot use "
+                                   f"({type(exc).__name__}: {exc})")
     finally:
         del scene
-        keep.reverse()     # wrappers first, the scene (kept first) last
-        keep.clear()
+        release(keep)
+    raise error
 
 
 def load_fbx(path):
@@ -239,10 +241,12 @@ def _read(scene, keep, path):
     fps = fps if np.isfinite(fps) and 1.0 <= fps <= 1000.0 else 30.0
     nodes = _Nodes(scene)
     for what, arr in (("translation", nodes.t), ("rotation", nodes.r), ("scale", nodes.s)):
-        if not np.all(np.isfinite(arr)):
-            raise RigFileError(path, f"expected finite node {what}s, got NaN or inf")
+        check_numbers(path, f"node {what}s", arr)
     mesh = read_skinned_meshes(scene, path, FbxWarning)
-    stacks = bake_stacks(scene, keep, fps)
+    check_numbers(path, "vertex positions", mesh.vertices)
+    for ibm in mesh.inverse_bind.values():
+        check_numbers(path, "cluster bind matrices", ibm)
+    stacks = bake_stacks(scene, keep, fps, path)
     moved = animated_nodes(stacks, {i: nodes.rest(i) for i in range(len(nodes.names))})
     skeleton, joint_of, prefix = _skeleton(path, nodes, mesh, moved)
     indices, weights = (_influences(mesh, joint_of, path) if len(mesh.vertices) else

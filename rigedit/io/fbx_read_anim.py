@@ -3,7 +3,7 @@
 ufbx evaluates each stack's curves (all layers, pre/post rotations, pivots and rotation
 orders included) into local translation, rotation and scale keys per node at the file's
 frame rate, plus the curves' own key times (``bake_anim``; its key reduction off; at most
-:data:`MAX_SEGMENTS` samples between two keys). rigedit
+:data:`MAX_BAKED_KEYS` keys, checked before baking). rigedit
 then drops only the keys that the interpolation of their neighbours reproduces within
 :data:`EXACT` (linear for vectors, slerp for rotations), so sampling at any baked time gives
 the baked value. Keys of a joint below folded non-joint nodes are mapped through that
@@ -15,14 +15,18 @@ import numpy as np
 
 from ..animation.clip import Clip, Track
 from ..animation.morph_track import WeightTrack
+from ..errors import RigFileError
 from .fbx_read_scene import call, ufbx_module
 from .gltf_anim import clip_names, quat_left_matrix
+from .jsonfile import MAX_SECONDS
 
 __all__ = ["bake_stacks", "animated_nodes", "clips_of", "weight_tracks", "reduce_keys",
            "EXACT"]
 
-#: Most samples ufbx takes between two keys of a curve (an hour at 30 frames per second).
-MAX_SEGMENTS = 108_000
+#: Most keys a take may bake to (animated values times frames of the file's time range):
+#: 5 million is a 9-minute take of 100 joints at 30 frames per second; reading costs about
+#: 400 bytes a key while the take is converted (ufbx's keys are Python objects until then).
+MAX_BAKED_KEYS = 5_000_000
 
 #: A key is dropped when its neighbours' interpolation gives it within this (file units
 #: after conversion: metres, unit quaternion components, scale factors).
@@ -144,7 +148,7 @@ def _track(channel, times, values, prefix, shift):
                  "slerp" if channel == "rotation" else "linear")
 
 
-def bake_stacks(scene, keep, fps):
+def bake_stacks(scene, keep, fps, path):
     """Every animation stack baked by ufbx: a list of ``(name, begin, end, nodes,
     elements)`` with ``nodes`` node typed id -> channel -> ((K,) times, (K, C) local values)
     and ``elements`` element id -> animated property -> ((K,) times, (K,) first components).
@@ -156,20 +160,31 @@ def bake_stacks(scene, keep, fps):
         The read's keep-alive list (:mod:`.fbx_read_scene`).
     fps : float
         The file's frame rate (a key at every frame).
+    path : Path
+        For the messages: times beyond :data:`~rigedit.io.jsonfile.MAX_SECONDS` and more than
+        :data:`MAX_BAKED_KEYS` keys to bake are errors.
     """
     ufbx = ufbx_module()
     stacks = scene.anim_stacks
     out = []
-    curves = scene.anim_curves
-    curve_span = (max(float(c.max_time) for c in curves) - min(float(c.min_time) for c in curves)
-                  if curves else 0.0)
+    times = [t for c in scene.anim_curves for t in (float(c.min_time), float(c.max_time))]
+    times += [t for s in stacks for t in (float(s.time_begin), float(s.time_end))]
+    if not all(abs(t) <= MAX_SECONDS for t in times):
+        raise RigFileError(path, f"expected animation times within {MAX_SECONDS:g} s, got "
+                                 f"{max(times, key=abs):g}")
+    curve_span = max(times, default=0.0) - min(times, default=0.0)
     for name, stack in zip(clip_names([s.name for s in stacks]), stacks):
+        # what baking will make is bounded before ufbx makes it: a key per frame of the
+        # file's whole time range for every animated value of the take
+        frames = curve_span * fps
+        values = sum(len(layer.anim_values) for layer in stack.layers)
+        if frames * max(values, 1) > MAX_BAKED_KEYS:
+            raise RigFileError(path, f"take {name!r}: expected at most {MAX_BAKED_KEYS} keys to "
+                                     f"bake, got {values} animated values over {frames:.0f} "
+                                     "frames")
         # ufbx samples a key interval at most max_keyframe_segments times (30 by default:
-        # a bezier curve keyed every 10 s would get no key at most frames), so allow every
-        # frame of the take, bounded (a file's time range is a claim)
-        frames = max(float(stack.time_end) - float(stack.time_begin), curve_span) * fps
-        segments = int(min(MAX_SEGMENTS, max(32, np.ceil(frames) + 1 if np.isfinite(frames)
-                                              else MAX_SEGMENTS)))
+        # a bezier curve keyed every 10 s would get no key at most frames)
+        segments = int(max(32, np.ceil(frames) + 1))
         bake = call(ufbx.bake_anim, scene, stack.anim, keep=keep, resample_rate=fps,
                     minimum_sample_rate=fps, key_reduction_enabled=False,
                     trim_start_time=False, max_keyframe_segments=segments)

@@ -23,9 +23,10 @@ from ..surface import Material, Surface
 from .fbx_read_scene import matrix_of
 from .fbx_read_shapes import merge_shapes, mesh_shapes
 from .gltf_mesh import decode_image
+from .jsonfile import MAX_MAGNITUDE
 from .paths import read_bytes
 
-__all__ = ["read_skinned_meshes", "SkinnedMeshes", "MAX_INFLUENCES"]
+__all__ = ["read_skinned_meshes", "SkinnedMeshes", "MAX_INFLUENCES", "check_numbers"]
 
 #: Influences kept per vertex (the largest, as the file orders them after ufbx's cleaning).
 MAX_INFLUENCES = 8
@@ -80,6 +81,17 @@ def triangulate(face_begin, face_count, corner_pos):
         for k in range(1, n - 1):
             out.append(np.stack([b, b + k, b + k + 1], axis=1))
     return np.concatenate(out).astype(np.int64) if out else np.zeros((0, 3), np.int64)
+
+
+def check_numbers(path, what, values):
+    """Finite and at most :data:`~rigedit.io.jsonfile.MAX_MAGNITUDE` in magnitude (in metres),
+    as every reader's coordinates, so that skinning cannot overflow."""
+    values = np.asarray(values)
+    if not np.all(np.isfinite(values)):
+        raise RigFileError(path, f"expected finite {what}, got NaN or inf")
+    if values.size and np.abs(values).max() > MAX_MAGNITUDE:
+        raise RigFileError(path, f"expected {what} of at most {MAX_MAGNITUDE:g} in magnitude, "
+                                 f"got {np.abs(values).max():g}")
 
 
 def _corner_attribute(attr, count, width):
@@ -139,6 +151,7 @@ def _mesh_parts(mesh, node, path, part_offset, material_index, warning):
     and its triangles."""
     skin = mesh.skin_deformers[0]
     points = np.asarray(mesh.vertices, dtype=np.float64).reshape(-1, 3)
+    check_numbers(path, f"vertex positions of mesh {mesh.name!r}", points)
     m = matrix_of(skin.clusters[0].geometry_to_world) if skin.clusters else \
         matrix_of(node.geometry_to_world)
     corner_point = np.asarray(mesh.vertex_indices, dtype=np.int64)

@@ -2,12 +2,15 @@
 
 Two things about the ``ufbx`` Python binding (0.0.5) shape this module:
 
-- **Its wrappers must outlive every use.** An element, list or sub-object wrapper that is
-  freed and fetched again crashes the process (a use-after-free in the binding: fetching
-  ``mesh.vertices`` twice after dropping the first result, or ``scene.nodes[1].name`` twice,
-  is a segmentation fault). :class:`Held` therefore fetches every attribute once and keeps it
-  (and every wrapper it came from) until the read is over; the readers touch ufbx objects
-  only through it.
+- **Its reference counts are wrong.** A list returns an element it made before without a
+  new reference (and more objects come back a reference short): fetching
+  ``scene.nodes[1].name`` twice, or ``mesh.vertices`` again after dropping the first result,
+  is a segmentation fault, and so, at random (1 run in 10 of four reads of mixamo.fbx), is
+  freeing a read's objects in any order. :class:`Held` therefore fetches every attribute
+  once and keeps it, and every ufbx wrapper fetched is pinned (:func:`_pin`): never freed.
+  That leaks the wrappers and the ufbx scene of each read (about 30 MB for mixamo.fbx) until
+  the process ends, the price of never crashing. The readers touch ufbx objects only
+  through :class:`Held`.
 - **It exposes no allocator limits** (ufbx's ``temp_allocator`` / ``result_allocator``
   memory and allocation limits are not among ``LoadOpts``; unknown keywords are ignored
   silently). The bound on what a file can make ufbx allocate is therefore checked before
@@ -16,7 +19,9 @@ Two things about the ``ufbx`` Python binding (0.0.5) shape this module:
 """
 from __future__ import annotations
 
+import ctypes
 import re
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +30,8 @@ from ..errors import RigFileError
 from .fbx_read_limits import check_claims
 from .paths import read_bytes
 
-__all__ = ["Held", "open_scene", "call", "matrix_of", "target_axes", "NODE_DEPTH_LIMIT"]
+__all__ = ["Held", "open_scene", "opened", "release", "call", "matrix_of", "target_axes",
+           "NODE_DEPTH_LIMIT"]
 
 #: Deeper node hierarchies are refused (ufbx's ``node_depth_limit``).
 NODE_DEPTH_LIMIT = 1000
@@ -41,12 +47,26 @@ def ufbx_module():
     return ufbx
 
 
+class Keep(list):
+    """The wrappers a read fetched (and its :class:`Held` objects)."""
+
+
+def _pin(value):
+    """Give a ufbx wrapper one reference of its own, never returned: the binding returns
+    some objects with a reference too few (a list hands out an element it made before
+    without a new one: ``sys.getrefcount`` does not grow when ``scene.nodes[1]`` is indexed
+    twice), so counting them right is not possible from here; a wrapper pinned once per
+    fetch is never freed, so never freed while in use or in the wrong order."""
+    ctypes.pythonapi.Py_IncRef(ctypes.py_object(value))
+
+
 def _hold(value, keep):
     """``value`` made safe to keep: plain data as it is, a ufbx list as a numpy array or a
     list of held items, another ufbx object as a :class:`Held`; the wrapper kept alive."""
     if isinstance(value, _PLAIN) or not type(value).__module__.startswith("ufbx"):
         return value
     keep.append(value)
+    _pin(value)
     kind = type(value).__name__
     if kind in _BUFFER_LISTS:
         return np.array(memoryview(value), dtype=np.float64)   # a copy, owned by numpy
@@ -74,6 +94,10 @@ class Held:
 
     def __init__(self, obj, keep):
         self._obj, self._cache, self._keep = obj, {}, keep
+        keep.append(self)        # so that release() can drop its wrappers whoever holds it
+
+    def _drop(self):
+        self._obj, self._cache = None, {}
 
     @property
     def raw(self):
@@ -84,6 +108,28 @@ class Held:
         if name not in cache:
             cache[name] = _hold(getattr(self._obj, name), self._keep)
         return cache[name]
+
+
+def release(keep):
+    """End a read: every :class:`Held` lets go of what it fetched (a traceback or a caller
+    may still hold one) and ``keep`` is emptied. The ufbx wrappers themselves stay (pinned,
+    see :func:`_pin`): freeing them crashes the binding at random, whatever the order."""
+    for item in keep:
+        if isinstance(item, Held):
+            item._drop()
+    keep.clear()
+
+
+@contextmanager
+def opened(path, convert=True):
+    """``with opened(path) as scene:`` :func:`open_scene` and :func:`release` around a
+    block (a held scene whose ``keep`` is ``scene._keep``)."""
+    scene, keep = open_scene(path, convert)
+    try:
+        yield scene
+    finally:
+        del scene
+        release(keep)
 
 
 def call(function, *args, keep, **kwargs):
@@ -126,15 +172,17 @@ def _options(path):
         filename=str(path))
 
 
-def open_scene(path):
-    """Load the FBX file ``path`` with ufbx, converted to metres, Y up, +Z forward.
+def open_scene(path, convert=True):
+    """Load the FBX file ``path`` with ufbx, converted to metres, Y up, +Z forward (as the
+    file is when ``convert`` is False).
 
     Returns
     -------
     scene : Held
         The scene (see :class:`Held`).
     keep : list
-        Every wrapper fetched so far; the caller keeps it until its read is done.
+        Every wrapper fetched (and every :class:`Held`); the caller passes it to
+        :func:`release` when its read is done, also when it failed.
 
     Raises
     ------
@@ -147,14 +195,18 @@ def open_scene(path):
     check_claims(data, path)
     ufbx = ufbx_module()
     try:
-        raw = ufbx.load_memory(data, **_options(path))
+        options = _options(path) if convert else dict(load_external_files=False,
+                                                       filename=str(path))
+        raw = ufbx.load_memory(data, **options)
     except ufbx.UfbxError as exc:
         raise RigFileError(path, f"expected a valid FBX file, got one ufbx cannot read "
                                  f"({_ufbx_problem(exc)})") from None
     except (MemoryError, OverflowError) as exc:
         raise RigFileError(path, f"expected an FBX file rigedit can hold in memory, got "
                                  f"one that does not fit ({type(exc).__name__})") from None
-    keep = [raw]
+    keep = Keep()
+    keep.append(raw)
+    _pin(raw)
     return Held(raw, keep), keep
 
 

@@ -16,6 +16,7 @@ from rigedit.errors import RigFileError
 from rigedit.io.fbx_read import read_fbx
 from rigedit.io.fbx_read_anim import reduce_keys
 from rigedit.io.fbx_read_limits import check_claims
+from rigedit.io.fbx_read_scene import opened
 from rigedit.rig import Rig
 from testpaths import DATA
 
@@ -55,13 +56,11 @@ def _need(*paths):
 def _file_frame(fbx):
     """(3, 3) map from the file's coordinates to rigedit's (metres, Y up, +Z forward), and
     each take's start, from the file's own settings (ufbx without conversion)."""
-    import ufbx
-
-    scene = ufbx.load_file(str(fbx))
-    settings = scene.settings          # each ufbx attribute fetched once (see fbx_read_scene)
-    unit, axes = settings.unit_meters, settings.axes
-    stacks = list(scene.anim_stacks)
-    starts = {s.name: s.time_begin for s in stacks}
+    # ufbx's objects through fbx_read_scene's holder (each fetched once, freed in order)
+    with opened(fbx) as converted:
+        starts = {s.name: s.time_begin for s in converted.anim_stacks}
+    with opened(fbx, convert=False) as scene:          # as the file is
+        unit, axes = scene.settings.unit_meters, scene.settings.axes
     unit_vector = {0: (1, 0, 0), 1: (-1, 0, 0), 2: (0, 1, 0), 3: (0, -1, 0), 4: (0, 0, 1),
                    5: (0, 0, -1)}
     right, up, front = (int(a) for a in (axes.right, axes.up, axes.front))
@@ -168,6 +167,19 @@ def test_reading_twice_in_one_process():
     assert np.array_equal(first.vertices, second.vertices)
 
 
+def test_many_reads_in_one_process_never_crash():
+    # the binding's reference counts are wrong; before every wrapper was pinned, four reads
+    # of mixamo.fbx and a collection crashed about one process in ten, at random
+    _need(MIXAMO)
+    code = ("import gc, warnings; warnings.simplefilter('ignore')\n"
+            "from rigedit.io.fbx_read import read_fbx\n"
+            f"for _ in range(6):\n    read_fbx({str(MIXAMO)!r}); gc.collect()\n"
+            "print('ok')")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0 and proc.stdout.strip() == "ok", proc.stderr[-500:]
+
+
 def test_key_reduction_is_exact():
     rng = np.random.default_rng(1)
     for _ in range(200):
@@ -217,12 +229,29 @@ def test_a_sparse_curve_is_baked_at_every_frame(tmp_path):
     assert len(frames) > 470 and np.allclose(frames, clip.morph_tracks["Raise"].times * 24)
     # and at every frame the clip's weight is the curve's (ufbx evaluates it)
     import ufbx
-    from rigedit.io.fbx_read_scene import call, open_scene
-    scene, keep = open_scene(path)
-    curve = scene.anim_curves[0]
-    for k in range(0, 20 * 24 + 1, 7):
-        expected = call(ufbx.evaluate_curve, curve, k / 24, 0.0, keep=keep) / 100
-        assert abs(clip.sample_morphs(k / 24)["Raise"] - expected) < 1e-6
+    from rigedit.io.fbx_read_scene import call
+    with opened(path) as scene:
+        curve = scene.anim_curves[0]
+        expected = [call(ufbx.evaluate_curve, curve, k / 24, 0.0, keep=scene._keep) / 100
+                    for k in range(0, 20 * 24 + 1, 7)]
+    for k, value in zip(range(0, 20 * 24 + 1, 7), expected):
+        assert abs(clip.sample_morphs(k / 24)["Raise"] - value) < 1e-6
+
+
+@pytest.mark.parametrize("keys,edit,message", [
+    ([(0.0, 0.0), (1e7, 100.0)], None, "animation times within"),
+    # a cubic curve over 10 days at 24 fps: 21 million keys to bake
+    ([(0.0, 0.0), (5e5, 100.0), (9e5, 0.0)], ("a: 260", "a: 1032"), "keys to bake"),
+    ([(0.0, 0.0), (1.0, 0.0)], ("a: 0,0,0,100,0,0", "a: 0,0,0,1e300,0,0"), r"at most 1e\+09"),
+    ([(0.0, 0.0), (1.0, 0.0)], ("a: 0,0,0,100,0,0", "a: 0,0,0,nan,0,0"), "finite"),
+])
+def test_claims_beyond_the_bounds_are_one_error(tmp_path, keys, edit, message):
+    path = tmp_path / "claim.fbx"
+    text = mini_fbx(keys)
+    path.write_text(text if edit is None else text.replace(*edit))
+    with pytest.raises(RigFileError, match=message) as err:
+        read_fbx(path)
+    assert err.value.path == str(path)
 
 
 def _png(path):
