@@ -47,7 +47,8 @@ def cmd_info(args):
              else "from file"),
             ("up", rig.up), ("bounds_min", " ".join(f"{v:.4g}" for v in lo)),
             ("bounds_max", " ".join(f"{v:.4g}" for v in hi)),
-            ("clips", " ".join(sorted(rig.clips)) or "-")]
+            ("clips", " ".join(sorted(rig.clips)) or "-"),
+            ("shapes", " ".join(rig.morphs.names) if rig.morphs is not None else "-")]
     rows += sorted(rig.meta.notes.items())  # what a reader decided: units, frames
     for key, value in rows:
         print(f"{key}: {value}")

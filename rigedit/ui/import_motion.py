@@ -24,8 +24,8 @@ from .menus import make_action
 __all__ = ["ImportMotion", "motion_path"]
 
 MAP_FILTERS = "Joint map (*.json);;All files (*)"
-FILTERS = ("Motion (*.bvh *.glb *.gltf skeleton.json);;BVH (*.bvh);;glTF (*.glb *.gltf);;"
-           "Rig folder (skeleton.json)")
+FILTERS = ("Motion (*.bvh *.glb *.gltf *.fbx skeleton.json);;BVH (*.bvh);;glTF (*.glb *.gltf);;"
+           "FBX (*.fbx);;Rig folder (skeleton.json)")
 
 
 def _names(names, most=8):
