@@ -203,18 +203,39 @@ def _scale_option(s):
 
 
 def build_parser():
+    """The ``rigedit`` parser: one subcommand per job, each added by its ``_add_*``."""
     p = argparse.ArgumentParser(prog="rigedit", description="Rig editor for 3D characters: "
-                                "headless jobs. RIG is a rig folder, a .glb/.gltf/.bvh file or a "
-                                "bundled name (quadruped, the default, or humanoid).")
+                                "headless jobs. RIG is a rig folder, a .glb/.gltf/.fbx/.bvh "
+                                "file or a bundled name (quadruped, the default, or humanoid).")
     sub = p.add_subparsers(dest="command", required=True)
+    _add_info(sub)
+    _add_list(sub)
+    _add_weights(sub)
+    _add_render(sub)
+    _add_export(sub)
+    _add_retarget(sub)
+    _add_autorig(sub)
+    return p
+
+
+def _add_info(sub):
+    """``rigedit info``'s options."""
     s = sub.add_parser("info", help="print facts about a rig as key: value lines")
     s.add_argument("rig", nargs="?")
     _scale_option(s)
     s.set_defaults(func=cmd_info)
+
+
+def _add_list(sub):
+    """``rigedit list``'s options."""
     s = sub.add_parser("list", help="list a rig's clips and durations")
     s.add_argument("rig", nargs="?")
     _scale_option(s)
     s.set_defaults(func=cmd_list)
+
+
+def _add_weights(sub):
+    """``rigedit weights``'s options."""
     s = sub.add_parser("weights", help="compute skinning weights into a .npz file")
     s.add_argument("rig", nargs="?")
     s.add_argument("--method", default=None,
@@ -224,6 +245,10 @@ def build_parser():
     s.add_argument("-o", "--output", required=True, metavar="FILE.npz")
     _scale_option(s)
     s.set_defaults(func=cmd_weights)
+
+
+def _add_render(sub):
+    """``rigedit render``'s options."""
     s = sub.add_parser("render", help="render a clip off-screen to MP4 or GIF")
     s.add_argument("clip")
     s.add_argument("--rig")
@@ -241,6 +266,10 @@ def build_parser():
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     _scale_option(s)
     s.set_defaults(func=cmd_render)
+
+
+def _add_export(sub):
+    """``rigedit export``'s options."""
     s = sub.add_parser("export",
                        help="write a rig as glTF (.glb/.gltf), FBX, BVH or a rig folder")
     s.add_argument("rig")
@@ -253,6 +282,10 @@ def build_parser():
                         "import at scale 1) or m")
     _scale_option(s)
     s.set_defaults(func=cmd_export)
+
+
+def _add_retarget(sub):
+    """``rigedit retarget``'s options."""
     s = sub.add_parser("retarget", help="retarget a motion (BVH, glTF, rig folder) onto a rig")
     s.add_argument("motion", metavar="MOTION")
     s.add_argument("--to", required=True, metavar="RIG")
@@ -267,6 +300,10 @@ def build_parser():
     s.add_argument("-o", "--output", required=True, metavar="FOLDER|OUT.glb|CLIP.json")
     _scale_option(s)
     s.set_defaults(func=cmd_retarget)
+
+
+def _add_autorig(sub):
+    """``rigedit autorig``'s options."""
     s = sub.add_parser("autorig", help="embed a template skeleton in a static mesh, bind it "
                                        "and give it the template's clips")
     s.add_argument("mesh", metavar="MESH", help="OBJ, PLY, STL, VTK, VTU, VTP or a .glb/.gltf's mesh")
@@ -292,7 +329,6 @@ def build_parser():
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     s.add_argument("-o", "--output", required=True, metavar="RIG_FOLDER|OUT.glb")
     s.set_defaults(func=cmd_autorig)
-    return p
 
 
 def main(argv=None):
