@@ -338,3 +338,184 @@ def test_fuzz_rig_json(base):
         if rig is not None:
             assert rig.up in ("y", "z") and isinstance(rig.name, str)
     run()
+
+
+# ---------------------------------------------------------------------------- glTF, GLB, BVH
+#: What the glTF and BVH readers must also survive (issue 19): counts that claim terabytes,
+#: indices past every table, nesting thousands deep, numbers beyond float range.
+GLTF_RAW = ["1099511627776", "4294967295", "2147483647", "-2", "1e400", "-1e400", "3e38",
+            "[" * 2000 + "]" * 2000, '"/etc/passwd"', '"../../../../dev/zero"',
+            '"file:///etc/passwd"', '"data:,"', '"data:application/octet-stream;base64,@@"']
+BVH_TOKENS = ["inf", "-inf", "nan", "1e400", "1e30", "-1e30", "3e38", "0", "-0", "1e-320",
+              "\u00b3", "\uff13", "\u0663", "x", "", "999999999999", "{", "}", "JOINT",
+              "End Site", "CHANNELS", "MOTION"]
+
+
+@pytest.fixture(scope="module")
+def rig_files(tmp_path_factory):
+    """A small rig (3 joints, a clip) written by rigedit as GLB, embedded glTF and BVH."""
+    from rigedit.io.bvh_write import save_bvh
+    from rigedit.io.gltf_write import save_gltf
+
+    root = tmp_path_factory.mktemp("fuzz_rig")
+    rig = corpus.small_rig()
+    save_gltf(rig.data(), root / "r.glb")
+    save_gltf(rig.data(), root / "r.gltf")   # a data uri: one self-contained file
+    save_bvh(rig, root / "r.bvh")
+    scratch = root / "scratch"
+    scratch.mkdir()
+    return {name: (root / name).read_bytes() for name in ("r.glb", "r.gltf", "r.bvh")} | {
+        "scratch": scratch}
+
+
+def _rig_ok(result):
+    if result is not None:
+        assert len(result.skeleton) >= 1
+        assert np.all(np.isfinite(result.skin(result.rest_pose())))
+        for clip in result.clips.values():
+            pose = clip.sample(clip.duration / 2)
+            assert np.all(np.isfinite(pose.translation)) and np.all(np.isfinite(pose.rotation))
+
+
+def _load_rig(path):
+    import rigedit
+
+    return rigedit.load_rig(path, scale=0.01) if path.suffix == ".bvh" else \
+        rigedit.load_rig(path)
+
+
+def _glb_parts(data):
+    """(JSON object, BIN chunk bytes) of a GLB rigedit wrote."""
+    import struct
+
+    size = struct.unpack_from("<I", data, 12)[0]
+    doc = json.loads(data[20:20 + size])
+    rest = data[20 + size:]
+    return doc, rest[8:] if len(rest) >= 8 else b""
+
+
+def _glb(json_bytes, bin_chunk):
+    import struct
+
+    body = json_bytes + b" " * (-len(json_bytes) % 4)
+    chunks = struct.pack("<II", len(body), 0x4E4F534A) + body
+    if bin_chunk:
+        chunks += struct.pack("<II", len(bin_chunk), 0x004E4942) + bin_chunk
+    return b"glTF" + struct.pack("<II", 2, 12 + len(chunks)) + chunks
+
+
+@st.composite
+def gltf_claim(draw, doc):
+    """An accessor made to claim a huge count (with or without its bufferView, or sparse),
+    or a node made thousands deep, as JSON text."""
+    doc = copy.deepcopy(doc)
+    op = draw(st.sampled_from(["count", "unbacked", "sparse", "deep_extras", "chain"]))
+    accessors = doc.get("accessors") or [{}]
+    acc = accessors[draw(st.integers(0, len(accessors) - 1))]
+    if op == "count":
+        acc["count"] = draw(st.sampled_from([2**40, 2**31, 2**26 + 1, 10**6]))
+    elif op == "unbacked":
+        acc.pop("bufferView", None)
+        acc["count"] = draw(st.sampled_from([2**40, 2**28, 10**7, 10**5]))
+    elif op == "sparse":
+        view = acc.get("bufferView", 0)
+        acc["sparse"] = {"count": draw(st.sampled_from([2**31, 10**6, 2])),
+                         "indices": {"bufferView": view, "componentType": 5125},
+                         "values": {"bufferView": view}}
+    elif op == "deep_extras":
+        depth = draw(st.sampled_from([101, 900, 5000]))
+        doc.setdefault("nodes", [{}])[0]["extras"] = "@@DEEP@@"
+        return json.dumps(doc).replace('"@@DEEP@@"', "[" * depth + "]" * depth).encode()
+    else:
+        nodes = doc.setdefault("nodes", [])
+        n0 = len(nodes)
+        depth = draw(st.sampled_from([100, 3000]))
+        nodes += [{"children": [n0 + i + 1]} for i in range(depth - 1)] + [{}]
+    return json.dumps(doc).encode()
+
+
+def _address_space_cap(extra=2 * 2**30):
+    """Cap this process's address space at its current size plus ``extra`` for the block, so
+    that an allocation from a file's claim fails (MemoryError, a failed example) instead of
+    bringing the machine's OOM killer; returns a function that lifts the cap."""
+    import resource
+
+    with open("/proc/self/status") as fh:
+        size = next(int(line.split()[1]) * 1024 for line in fh if line.startswith("VmSize:"))
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    cap = size + extra
+    resource.setrlimit(resource.RLIMIT_AS, (cap if hard < 0 else min(cap, hard), hard))
+    return lambda: resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
+
+
+def _fuzz_rig_file(path, strategy):
+    @FUZZ
+    @given(strategy)
+    def run(data):
+        _rig_ok(_load_checked(_put(path, data), _load_rig))
+    lift = _address_space_cap()
+    try:
+        run()
+    finally:
+        lift()
+
+
+def test_fuzz_gltf(rig_files):
+    data = rig_files["r.gltf"]
+    doc = json.loads(data)
+    _fuzz_rig_file(rig_files["scratch"] / "f.gltf",
+                   st.one_of(byte_mutation(data), json_mutation(doc), json_mutation(doc),
+                             gltf_claim(doc), st.sampled_from(GLTF_RAW).map(
+                                 lambda raw: data.replace(b'"count":', b'"count":' +
+                                                          raw.encode() + b', "x":'))))
+
+
+def test_fuzz_glb(rig_files):
+    data = rig_files["r.glb"]
+    doc, bin_chunk = _glb_parts(data)
+    # structural edits of the JSON chunk, repacked so the container stays valid and the
+    # edit reaches the readers behind it; and raw byte edits of the container itself
+    repacked = st.one_of(json_mutation(doc), gltf_claim(doc)).map(
+        lambda text: _glb(text, bin_chunk))
+    _fuzz_rig_file(rig_files["scratch"] / "f.glb",
+                   st.one_of(byte_mutation(data), byte_mutation(data), repacked, repacked))
+
+
+@st.composite
+def bvh_mutation(draw, text):
+    """BVH text with tokens replaced (non-finite, huge, non-ASCII digits, stray braces),
+    lines dropped or repeated, or the hierarchy nested thousands deep."""
+    lines = text.split("\n")
+    for _ in range(draw(st.integers(1, 3))):
+        op = draw(st.sampled_from(["token", "token", "drop", "repeat", "deep", "frames"]))
+        i = draw(st.integers(0, len(lines) - 1))
+        if op == "token":
+            words = lines[i].split(" ")
+            k = draw(st.integers(0, max(len(words) - 1, 0)))
+            words[k] = draw(st.sampled_from(BVH_TOKENS))
+            lines[i] = " ".join(words)
+        elif op == "drop":
+            del lines[i]
+        elif op == "repeat":
+            lines[i:i] = lines[i:i + draw(st.integers(1, 8))]
+        elif op == "deep":
+            depth = draw(st.sampled_from([999, 1001, 10000]))
+            at = next((n for n, line in enumerate(lines) if "End Site" in line), None)
+            if at is not None:
+                lines[at:at] = ["JOINT d{0}\n{{\nOFFSET 0 1 0".format(n)
+                                for n in range(depth)]
+                end = next(n for n in range(at + depth, len(lines)) if "}" in lines[n])
+                lines[end + 1:end + 1] = ["}"] * depth
+        else:
+            at = next((n for n, line in enumerate(lines) if line.startswith("Frames:")), None)
+            if at is not None:
+                lines[at] = "Frames: " + draw(st.sampled_from(["0", "inf", "nan", "-1",
+                                                               "\u00b3", "1e300", "2.5"]))
+    return "\n".join(lines).encode()
+
+
+def test_fuzz_bvh(rig_files):
+    data = rig_files["r.bvh"]
+    _fuzz_rig_file(rig_files["scratch"] / "f.bvh",
+                   st.one_of(byte_mutation(data), bvh_mutation(data.decode()),
+                             bvh_mutation(data.decode())))
