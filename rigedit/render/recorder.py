@@ -25,7 +25,7 @@ import numpy as np
 import pyvista as pv
 
 from ..errors import RigFileError
-from ..io.atomic import check_output_folder
+from ..io.atomic import check_output_folder, write_error
 from ..progress import Cancelled
 from .camera import apply_camera, figure_joints, horizontal, swept_points, turn_about
 from .floor import GRID_COLOR
@@ -194,6 +194,11 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         writer.commit()
         writer = None
         return len(times)
+    except OSError as exc:   # ffmpeg or the disk failed: one line naming the user's video
+        new = write_error(exc, path)
+        if new is exc:
+            raise
+        raise new from None
     finally:
         rig.binding.set_morph_weights(shown_weights)
         if writer is not None:

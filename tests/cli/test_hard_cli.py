@@ -139,3 +139,21 @@ def test_a_killed_renders_temporary_video_is_removed_by_the_next(tmp_path):
     assert main(["render", "bend", "--rig", str(rig_dir), "-o", str(out), "--size", "64x64",
                  "--duration", "0.2"]) == 0
     assert out.is_file() and _hidden(out_dir) == sorted([live.name, other.name])
+
+
+def test_a_video_that_cannot_be_written_is_one_line_naming_it(tmp_path, capsys, monkeypatch):
+    import errno
+
+    from rigedit.render import video_writer
+
+    def full(self, frame):
+        raise OSError(errno.ENOSPC, "No space left on device")
+    rig_dir = tmp_path / "rig"
+    save_rig_folder(rig_dir, cylinder_rig())
+    monkeypatch.setattr(video_writer.VideoWriter, "append", full)
+    out = tmp_path / "v.mp4"
+    assert main(["render", "bend", "--rig", str(rig_dir), "-o", str(out), "--size", "64x64",
+                 "--duration", "0.3"]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"rigedit: error: {out}: cannot write: No space left on device"]
+    assert not out.exists() and _hidden(tmp_path) == []
