@@ -110,7 +110,11 @@ def test_sigterm_early_in_a_render_never_crashes(tmp_path):
         outcomes.append(proc.returncode)
         assert proc.returncode in (143, -signal.SIGTERM, 0), (delay, proc.returncode, err)
         if proc.returncode == 143:
-            assert err.splitlines() == ["rigedit: interrupted by SIGTERM"], err
+            # rigedit's own words are one line; VTK may log its own warnings beside them (a
+            # busy X server under CI: "bad X server connection"), which are not a crash
+            ours = [line for line in err.splitlines() if line.startswith("rigedit:")]
+            assert ours == ["rigedit: interrupted by SIGTERM"], err
+            assert "Traceback" not in err and "Fatal Python error" not in err, err
         assert _hidden(tmp_path) == [], delay
     assert -signal.SIGSEGV not in outcomes
 
