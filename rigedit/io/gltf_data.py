@@ -1,6 +1,6 @@
 """glTF 2.0 containers and accessors: the GLB/JSON file, its buffers, and typed arrays.
 
-The JSON becomes pygltflib's objects (built directly from the parsed JSON, see ``_decode``);
+The JSON becomes pygltflib's objects (built directly from the parsed JSON: :mod:`rigedit.io.gltf_decode`);
 this module checks the GLB container itself (pygltflib accepts a wrong version or chunk
 lengths that disagree with the file) and decodes accessors
 into numpy arrays in one vectorised step each: byte strides, sparse substitution, normalised
@@ -10,10 +10,8 @@ Every problem is one :class:`~rigedit.errors.RigFileError` naming the file.
 from __future__ import annotations
 
 import base64
-import dataclasses
 import json
 import struct
-import typing
 import urllib.parse
 from pathlib import Path
 
@@ -21,6 +19,8 @@ import numpy as np
 
 from ..errors import RigFileError
 from .gltf_checks import check_document
+from .gltf_decode import decode as _decode
+from .gltf_decode import lib as _lib
 from .jsonfile import MAX_MAGNITUDE
 from .paths import read_bytes
 
@@ -44,58 +44,6 @@ SUPPORTED_EXTENSIONS = ("KHR_mesh_quantization",)
 #: never more than 2**26 in all (512 MiB as float64).
 CLAIM_ELEMENTS_PER_BYTE = 4
 MAX_CLAIMED_ELEMENTS = 2**26
-
-
-_HINTS = {}
-
-
-def _lib():
-    """pygltflib, imported on the first glTF read rather than with the format registry
-    (:mod:`rigedit.io.registry`): a process that opens only rig folders saves its ~0.07 s."""
-    import pygltflib
-
-    return pygltflib
-
-
-def _field_types(cls):
-    """{field name: dataclass type (or None), is a list} of one pygltflib class, cached."""
-    if cls not in _HINTS:
-        hints = typing.get_type_hints(cls)
-        out = {}
-        for f in dataclasses.fields(cls):
-            hint, many = hints.get(f.name), False
-            for _ in range(3):  # unwrap Optional[...] and List[...]
-                args = [a for a in typing.get_args(hint) if a is not type(None)]
-                if typing.get_origin(hint) in (list, typing.List):
-                    many = True
-                if not args:
-                    break
-                hint = args[0]
-            out[f.name] = (hint if dataclasses.is_dataclass(hint) or hint is _lib().Attributes
-                           else None, many)
-        _HINTS[cls] = out
-    return _HINTS[cls]
-
-
-def _decode(cls, data):
-    """A pygltflib object from parsed JSON: the same objects as ``GLTF2.from_json`` builds,
-    built directly (pygltflib's generic decoder took 0.6 s for CesiumMan's 300 objects, which
-    would grow to many seconds for a character with dozens of clips). Unknown keys are
-    dropped, missing ones keep pygltflib's defaults."""
-    attributes = _lib().Attributes
-    if cls is attributes:
-        return attributes(**data) if isinstance(data, dict) else data
-    if not isinstance(data, dict):
-        raise TypeError(f"expected an object for {cls.__name__}, got {type(data).__name__}")
-    kwargs = {}
-    for key, (sub, many) in _field_types(cls).items():
-        if key not in data:
-            continue
-        value = data[key]
-        if sub is not None and value is not None:
-            value = [_decode(sub, v) for v in value] if many else _decode(sub, value)
-        kwargs[key] = value
-    return cls(**kwargs)
 
 
 def _is_int(value):
