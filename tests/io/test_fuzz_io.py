@@ -519,3 +519,26 @@ def test_fuzz_bvh(rig_files):
     _fuzz_rig_file(rig_files["scratch"] / "f.bvh",
                    st.one_of(byte_mutation(data), bvh_mutation(data.decode()),
                              bvh_mutation(data.decode())))
+
+
+# ---------------------------------------------------------------------------- FBX
+FBX_FUZZ = settings(FUZZ, max_examples=max(FUZZ_EXAMPLES // 4, 5))
+
+
+def test_fuzz_fbx(rig_files):
+    """Binary FBX (the small rig as rigedit writes it) and ASCII FBX (tests/fbx_mini.py),
+    truncated, flipped, cut and repeated, read as users read them (rigedit.load_rig: ufbx in
+    a child process): each loads whole or is one RigFileError naming the file, never a crash
+    of this process, never a hang."""
+    from fbx_mini import mini_fbx
+    from rigedit.io.fbx_write import write_fbx
+
+    binary = rig_files["scratch"] / "src.fbx"
+    write_fbx(corpus.small_rig().data(), binary)
+    sources = [binary.read_bytes(), mini_fbx([(0.0, 0.0), (1.0, 100.0)]).encode()]
+
+    @FBX_FUZZ
+    @given(st.one_of(*[byte_mutation(data) for data in sources]))
+    def run(data):
+        _rig_ok(_load_checked(_put(rig_files["scratch"] / "f.fbx", data), _load_rig))
+    run()
