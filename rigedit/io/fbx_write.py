@@ -77,7 +77,7 @@ def fbx_bytes(rig, clips=None, units="cm"):
         mesh, geometry = write_mesh(scene, rig, unit)
         if rig.indices is not None and rig.weights is not None:
             write_skin(scene, rig, geometry, joints, unit)
-        morphs = getattr(rig, "morphs", None)
+        morphs = rig.morphs
         if morphs is not None and morphs.count:
             channels = write_morphs(scene, morphs, geometry, rig.name, unit)
     write_bind_pose(scene, rig.name, mesh, rig.skeleton, joints, unit)

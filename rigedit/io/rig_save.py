@@ -43,7 +43,6 @@ import numpy as np
 
 from ..animation.clip_names import check_clip_name
 from ..errors import RigFileError, RigWriteError
-from ..model.morph import MorphTargets
 from .atomic import check_output_folder, fsync_folder, write_error, write_json
 from .bundled import is_bundled
 from .clip_files import (ANIMATIONS, clip_entry, loaded_clip_files, plan_clip_files,
@@ -160,17 +159,14 @@ def _referenced(rig):
     """
     vertices, faces = np.asarray(rig.vertices), np.asarray(rig.faces)
     indices, weights = np.asarray(rig.indices), np.asarray(rig.weights)
-    morphs = getattr(rig, "morphs", None)
+    morphs = rig.morphs
     used = np.zeros(len(vertices), dtype=bool)
     used[faces.ravel()] = True
     if used.all():
         return vertices, faces, indices, weights, morphs
     remap = np.cumsum(used) - 1
     if morphs is not None:
-        morphs = MorphTargets(morphs.names, morphs.deltas[:, used],
-                              normal_deltas=None if morphs.normal_deltas is None
-                              else morphs.normal_deltas[:, used],
-                              default_weights=morphs.default_weights)
+        morphs = morphs.subset(np.flatnonzero(used))
     return vertices[used], remap[faces], indices[used], weights[used], morphs
 
 
