@@ -14,7 +14,7 @@ def run_autorig(args):
     (see :mod:`rigedit.cli.output`). A result that is NOT SURE (``report.sure``) prints
     each reason as a warning line; with ``args.strict`` it is an error and nothing is
     written."""
-    from .output import check_interrupted, warning_lines
+    from .output import check_interrupted, warn, warning_lines
     from ..errors import RigFileError
     from ..rigging.autorig.pipeline import autorig
 
@@ -50,7 +50,7 @@ def run_autorig(args):
     for line in report.lines():
         print(line)
     for reason in report.reasons:   # after the report, where a user looks last
-        print(f"rigedit: warning: NOT SURE: {reason}", file=sys.stderr)
+        warn(f"NOT SURE: {reason}")
     rig.save(args.output)
     print(f"wrote {Path(args.output).resolve()}: {len(rig.skeleton)} joints, "
           f"{len(rig.vertices)} vertices, clips: {' '.join(sorted(rig.clips)) or '-'}")

@@ -14,26 +14,17 @@ import sys
 import time
 from pathlib import Path
 
+from .common import LOAD_OPTIONS, UsageError, load, parse_size, scale_option
+
 __all__ = ["main", "build_parser"]
 
 EXIT_BAD_INPUT = 2
 
-
-class UsageError(Exception):
-    """Bad input that is not about a file (an unknown clip, a bad option value)."""
-
-
-#: Options of every rig the command loads (set by :func:`main` from ``--allow-outside-uris``).
-_LOAD_OPTIONS = {}
-
-
-def _load(rig_arg, method=None, scale=None):
-    import rigedit
-
-    from .output import warning_lines
-
-    with warning_lines():
-        return rigedit.load_rig(rig_arg, weights_method=method, scale=scale, **_LOAD_OPTIONS)
+# the shared pieces under their old names (tests and the subcommand modules use them)
+_LOAD_OPTIONS = LOAD_OPTIONS
+_load = load
+_parse_size = parse_size
+_scale_option = scale_option
 
 
 def cmd_info(args):
@@ -86,14 +77,6 @@ def cmd_weights(args):
     return 0
 
 
-def _parse_size(text):
-    try:
-        w, h = (int(v) for v in text.lower().split("x"))
-    except ValueError:
-        raise UsageError(f"--size: expected WIDTHxHEIGHT such as 1280x720, got {text!r}") from None
-    return w, h
-
-
 #: Sane ranges of the numeric options: (low, high, low is allowed). Anything outside, and any
 #: NaN or infinity, is one error line before the rig is even read.
 OPTION_RANGES = {"fps": (0.0, 240.0, False), "duration": (0.0, 3600.0, False),
@@ -120,67 +103,6 @@ def check_options(args):
                              f"{SIZE_RANGE[1]} pixels, got {w}x{h}")
 
 
-def cmd_render(args):
-    from .output import check_interrupted, deferred
-
-    # A signal raised while VTK's extension modules initialise can leave them half made and
-    # crash the interpreter's exit (SIGSEGV): the import only records it, and it is raised
-    # once the import is done.
-    with deferred():
-        from ..render.recorder import frame_times, record_clip
-    check_interrupted()
-    size = _parse_size(args.size)  # fps, duration and size were checked by check_options
-    rig = _load(args.rig, scale=args.scale)
-    if args.clip not in rig.clips:
-        raise UsageError(f"{rig.path}: unknown clip {args.clip!r}; clips: "
-                         f"{', '.join(sorted(rig.clips)) or 'none'}")
-    clip = rig.clips[args.clip]
-    bar = None
-    if sys.stderr.isatty() and not args.quiet:
-        from tqdm import tqdm
-
-        bar = tqdm(total=len(frame_times(args.duration or clip.duration or 1.0, args.fps)),
-                   unit="frame", desc=f"render {args.clip}")
-
-    def progress(fraction, stage):   # rigedit.progress's protocol
-        check_interrupted()
-        if bar is not None and fraction is not None:
-            bar.update(round(fraction * bar.total) - bar.n)
-
-    t0 = time.perf_counter()
-    try:
-        with deferred():   # a signal stops the render between frames (see cli_output)
-            n = record_clip(rig, clip, args.output, fps=args.fps, duration=args.duration,
-                            size=size, angle=args.angle, view=args.view,
-                            show_skeleton=args.skeleton, progress=progress,
-                            skinning=args.skinning)
-    finally:
-        if bar is not None:
-            bar.close()
-    dt = time.perf_counter() - t0
-    print(f"wrote {Path(args.output).resolve()}: {n} frames at {args.fps:g} fps, "
-          f"{size[0]}x{size[1]}, {dt:.1f} s ({n / dt:.1f} frames/s)")
-    return 0
-
-
-def cmd_export(args):
-    import rigedit
-
-    rig = _load(args.rig, scale=args.scale)
-    if Path(args.output).suffix.lower() == ".fbx":
-        from ..io.fbx_write import write_fbx
-
-        write_fbx(rig.data(), args.output, clips=args.clip, units=args.fbx_units)
-    else:
-        rigedit.save_rig(rig, args.output, clips=args.clip)
-    clips = args.clip or sorted(rig.clips)
-    if Path(args.output).suffix.lower() == ".bvh":
-        clips = clips[:1]
-    print(f"wrote {Path(args.output).resolve()}: {len(rig.skeleton)} joints, "
-          f"{len(rig.vertices)} vertices, clips: {' '.join(clips) or '-'}")
-    return 0
-
-
 def cmd_retarget(args):
     from .retarget import run_retarget
 
@@ -193,15 +115,6 @@ def cmd_autorig(args):
     return run_autorig(args)
 
 
-def _scale_option(s):
-    """The options of the rigs a command reads: ``--scale`` and ``--allow-outside-uris``."""
-    s.add_argument("--scale", type=float, default=None, metavar="M",
-                   help="metres per file unit of a .bvh RIG (default: guessed from its height)")
-    s.add_argument("--allow-outside-uris", action="store_true",
-                   help="let a .gltf read buffers and images outside its folder (absolute "
-                        "paths, '..', file:); off by default")
-
-
 def build_parser():
     """The ``rigedit`` parser: one subcommand per job, each added by its ``_add_*``."""
     p = argparse.ArgumentParser(prog="rigedit", description="Rig editor for 3D characters: "
@@ -211,10 +124,16 @@ def build_parser():
     _add_info(sub)
     _add_list(sub)
     _add_weights(sub)
-    _add_render(sub)
-    _add_export(sub)
+    from . import export, render
+
+    render.add_parser(sub)
+    export.add_parser(sub)
     _add_retarget(sub)
     _add_autorig(sub)
+    for s in sub.choices.values():   # every command is quiet on request
+        if not any("-q" in a.option_strings for a in s._actions):
+            s.add_argument("-q", "--quiet", action="store_true",
+                           help="print nothing but errors")
     return p
 
 
@@ -247,43 +166,6 @@ def _add_weights(sub):
     s.set_defaults(func=cmd_weights)
 
 
-def _add_render(sub):
-    """``rigedit render``'s options."""
-    s = sub.add_parser("render", help="render a clip off-screen to MP4 or GIF")
-    s.add_argument("clip")
-    s.add_argument("--rig")
-    s.add_argument("-o", "--output", required=True, metavar="OUT.mp4|OUT.gif")
-    s.add_argument("--fps", type=float, default=30.0)
-    s.add_argument("--duration", type=float, default=None, metavar="S",
-                   help="seconds to render (default: the clip's duration)")
-    s.add_argument("--angle", type=float, default=0.0, metavar="DEG",
-                   help="turn the front camera about the vertical axis")
-    s.add_argument("--view", choices=("front", "side", "back", "top"), default="front")
-    s.add_argument("--size", default="1280x720", metavar="WxH")
-    s.add_argument("--skeleton", action="store_true", help="draw the bones too")
-    s.add_argument("--skinning", choices=("lbs", "dqs"), default="lbs",
-                   help="linear blend (default) or dual-quaternion skinning")
-    s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
-    _scale_option(s)
-    s.set_defaults(func=cmd_render)
-
-
-def _add_export(sub):
-    """``rigedit export``'s options."""
-    s = sub.add_parser("export",
-                       help="write a rig as glTF (.glb/.gltf), FBX, BVH or a rig folder")
-    s.add_argument("rig")
-    s.add_argument("-o", "--output", required=True,
-                   metavar="OUT.glb|OUT.gltf|OUT.fbx|OUT.bvh|FOLDER")
-    s.add_argument("--clip", action="append", default=None, metavar="NAME",
-                   help="a clip to write (repeat for several; default all, BVH: the first)")
-    s.add_argument("--fbx-units", choices=("cm", "m"), default="cm",
-                   help="length unit of an .fbx OUT: cm (the default, what Unity and Unreal "
-                        "import at scale 1) or m")
-    _scale_option(s)
-    s.set_defaults(func=cmd_export)
-
-
 def _add_retarget(sub):
     """``rigedit retarget``'s options."""
     s = sub.add_parser("retarget", help="retarget a motion (BVH, glTF, rig folder) onto a rig")
@@ -299,7 +181,7 @@ def _add_retarget(sub):
                         "the spine or the head unmapped")
     s.add_argument("-o", "--output", required=True, metavar="FOLDER|OUT.glb|CLIP.json")
     _scale_option(s)
-    s.set_defaults(func=cmd_retarget)
+    s.set_defaults(func=cmd_retarget, folder_output=True)
 
 
 def _add_autorig(sub):
@@ -326,9 +208,20 @@ def _add_autorig(sub):
     s.add_argument("--strict", action="store_true",
                    help="a result that is NOT SURE (a failed check, an orientation without a "
                         "clear winner) is an error: exit 2, nothing written")
-    s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    s.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors (no progress bar)")
     s.add_argument("-o", "--output", required=True, metavar="RIG_FOLDER|OUT.glb")
-    s.set_defaults(func=cmd_autorig)
+    s.set_defaults(func=cmd_autorig, folder_output=True)
+
+
+def _quietly(args):
+    """Run the command with its report lines and warnings dropped (``-q``): errors still
+    reach stderr, printed by :func:`main`."""
+    import contextlib
+
+    from .output import quiet_warnings
+
+    with open(os.devnull, "w") as null, contextlib.redirect_stdout(null), quiet_warnings():
+        return args.func(args)
 
 
 def main(argv=None):
@@ -346,8 +239,9 @@ def main(argv=None):
         with interruptible():
             check_options(args)
             if getattr(args, "output", None) is not None:
-                check_output(args.output, folder_ok=args.func in (cmd_export, cmd_retarget,
-                                                                    cmd_autorig))
+                check_output(args.output, folder_ok=getattr(args, "folder_output", False))
+            if getattr(args, "quiet", False):
+                return _quietly(args)
             return args.func(args)
     except Interrupted as exc:
         print(f"rigedit: interrupted by {exc}", file=sys.stderr)

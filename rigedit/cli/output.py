@@ -24,12 +24,14 @@ from ..errors import RigFileError
 from ..io.atomic import check_output_folder
 
 __all__ = ["Interrupted", "interruptible", "check_interrupted", "deferred", "check_output",
-           "warning_lines"]
+           "warning_lines", "quiet_warnings", "warn"]
 
 #: Signals received within :func:`interruptible`, oldest first.
 _received = []
 #: True within :func:`deferred`.
 _deferring = [False]
+#: True within :func:`quiet_warnings` (``-q``).
+_quiet = [False]
 
 
 class Interrupted(BaseException):
@@ -99,8 +101,26 @@ def warning_lines():
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         yield
+    if _quiet[0]:
+        return
     for w in caught:
         print(f"rigedit: warning: {w.message}", file=sys.stderr)
+
+
+def warn(message):
+    """Print ``rigedit: warning: message`` on stderr, unless quiet (``-q``)."""
+    if not _quiet[0]:
+        print(f"rigedit: warning: {message}", file=sys.stderr)
+
+
+@contextlib.contextmanager
+def quiet_warnings():
+    """Within the block, :func:`warning_lines` prints nothing (``-q``: errors only)."""
+    _quiet[0] = True
+    try:
+        yield
+    finally:
+        _quiet[0] = False
 
 
 def check_output(path, folder_ok=False):

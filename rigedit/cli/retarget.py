@@ -5,6 +5,7 @@ import sys
 from pathlib import Path
 
 from ..errors import RigFileError
+from .output import warn
 
 __all__ = ["run_retarget"]
 
@@ -53,7 +54,7 @@ def run_retarget(args, load):
                 f"keep their rest pose): {'; '.join(missing)}")
         if args.strict:
             raise RigFileError(args.to, f"{what}; give a joint map (--map) or drop --strict")
-        print(f"rigedit: warning: {args.to}: {what}", file=sys.stderr)
+        warn(f"{args.to}: {what}")
     print(f"calibration: source {res.source_calibration.source}, target "
           f"{res.target_calibration.source}; facing turn {res.facing_degrees:g} deg; "
           f"scale {res.scale:.3f}; contact frames {res.contact.any(axis=1).sum()} of "
@@ -77,7 +78,7 @@ def run_retarget(args, load):
         save_clip(out, new)
     else:
         if new.name in target.clips:
-            print(f"rigedit: warning: replacing the target's clip {new.name!r}", file=sys.stderr)
+            warn(f"replacing the target's clip {new.name!r}")
         target.clips[new.name] = new
         target.save(out, clips=[new.name] if out.suffix.lower() == ".bvh" else None)
     print(f"wrote {out.resolve()}: clip {new.name!r}, {new.duration:.2f} s, "

@@ -40,6 +40,25 @@ def test_weights_command_writes_npz(rig_dir, tmp_path, capsys):
         assert np.allclose(data["weights"].sum(axis=1), 1.0, atol=1e-6)
 
 
+def test_quiet_prints_nothing_but_errors(rig_dir, tmp_path, capsys):
+    """-q on every command: the report lines and the warnings go (a weights file computed on
+    load warns), an error line stays."""
+    from rigedit.cli.main import build_parser
+
+    sub = next(a for a in build_parser()._actions if a.dest == "command")
+    for name, parser in sub.choices.items():
+        assert any("-q" in a.option_strings for a in parser._actions), name
+    (rig_dir / "weights.npz").unlink()   # loading then computes them, with a warning
+    assert main(["info", str(rig_dir)]) == 0
+    loud = capsys.readouterr()
+    assert "vertices:" in loud.out and "rigedit: warning" in loud.err
+    assert main(["export", str(rig_dir), "-o", str(tmp_path / "c.glb"), "-q"]) == 0
+    quiet = capsys.readouterr()
+    assert quiet.out == "" and quiet.err == "" and (tmp_path / "c.glb").stat().st_size > 0
+    assert main(["info", str(tmp_path / "none"), "-q"]) == 2
+    assert "rigedit: error" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("argv,msg", [
     (["info", "{missing}"], "expected a rig folder, got nothing (not found)"),
     (["render", "nope", "--rig", "{rig}", "-o", "{tmp}/x.mp4"], "unknown clip 'nope'"),
