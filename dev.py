@@ -27,6 +27,7 @@ DEBIAN_PACKAGES = [
     "libxcb-shape0", "libxcb-cursor0", "libxcb-xkb1", "libxrender1", "libxext6", "libsm6",
     "libice6", "libfontconfig1", "libdbus-1-3", "libxt6",
     "libsuitesparse-dev",  # CHOLMOD for the heat weights' solver (scikit-sparse builds on it)
+    "chromium",  # headless browser: the batch report's tests load report.html in it
 ]
 
 
