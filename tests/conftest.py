@@ -9,6 +9,10 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 # ($XDG_CACHE_HOME/rigedit): keep the tests' (and their subprocesses') out of the real one.
 os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp(prefix="rigedit-test-cache-")
 atexit.register(shutil.rmtree, os.environ["XDG_CACHE_HOME"], True)
+# The weights cache (rigedit/binding/weights_cache.py) is off for the whole session: a test
+# that loads a folder without weights.npz computes them, as before; its own tests point it at
+# tmp_path.
+os.environ["RIGEDIT_CACHE_DIR"] = "off"
 
 import sys
 from pathlib import Path
