@@ -173,7 +173,7 @@ def _read(folder):
     # A weights file fixes the vertex order: keep the mesh's vertices as they are when the
     # weights fit them (a saved rig whose mesh has coincident vertices, such as split
     # normals), and weld seam duplicates otherwise (the elk layout's OBJ exports).
-    vertices, faces = read_mesh(weld=False)
+    vertices, faces = read_mesh(weld=files["weights"] is None)   # read once without weights
     indices = weights = None
     if files["weights"] is not None:
         if weights_vertex_count(files["weights"]) != len(vertices):
@@ -181,8 +181,6 @@ def _read(folder):
         indices, weights = load_weights(files["weights"], skeleton, len(vertices))
     elif not files["meshes"]:
         indices, weights = np.zeros((0, 1), dtype=np.int64), np.zeros((0, 1))
-    else:
-        vertices, faces = read_mesh(weld=True)
     # the elk layout's skeleton may be Z up over a Y-up mesh (rigedit/io/frames.py)
     skeleton, up, frames_note, clip_change = resolve_folder_frames(
         folder, skeleton, meta, vertices, files["manifest"])
