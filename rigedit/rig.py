@@ -9,6 +9,7 @@ from .io.data import RigData, RigMeta, WeightsComputedWarning, register_rig_buil
 from .model.kinematics import local_to_model, skinning_matrices
 from .model.pose import Pose
 from .model.skinning import SkinBinding
+from .binding import weights_cache
 from .binding.weights import compute_weights, default_method
 
 __all__ = ["Rig"]
@@ -91,10 +92,19 @@ class Rig:
         method = weights_method or default_method(data.faces)
         if indices is None:
             what = "no weights file" if data.meta.format == "folder" else "no skin weights"
-            warnings.warn(f"{data.meta.source}: {what}; computed weights ({method})",
+            # the weights of an earlier load of the same mesh, skeleton and method, if cached
+            key = weights_cache.weights_key(data.vertices, data.faces, data.skeleton, method)
+            cached = weights_cache.load_weights(key, len(data.vertices), len(data.skeleton))
+            how = f"computed weights ({method})" if cached is None else \
+                f"weights ({method}) from the cache of an earlier load"
+            warnings.warn(f"{data.meta.source}: {what}; {how}",
                           WeightsComputedWarning, stacklevel=3)
-            indices, weights = compute_weights(data.vertices, data.skeleton, method,
-                                               faces=data.faces)
+            if cached is None:
+                indices, weights = compute_weights(data.vertices, data.skeleton, method,
+                                                   faces=data.faces)
+                weights_cache.store_weights(key, indices, weights)
+            else:
+                indices, weights = cached
         rig = cls(data.skeleton, data.vertices, data.faces, indices, weights, data.clips,
                   name=data.name, up=data.up, weights_method=method, path=data.meta.source,
                   surface=data.surface, meta=data.meta, morphs=data.morphs)
