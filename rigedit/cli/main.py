@@ -127,6 +127,7 @@ def build_parser():
     from . import export, render
 
     render.add_parser(sub)
+    from . import batch; batch.add_parser(sub)  # noqa: E702  rigedit batch (issue 21)
     export.add_parser(sub)
     _add_retarget(sub)
     _add_autorig(sub)

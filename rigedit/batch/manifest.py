@@ -1,0 +1,136 @@
+"""The batch manifest: one JSON entry per task in ``OUTDIR/manifest/<task>.json``.
+
+Each entry is written whole by the client, to a temporary file renamed over the old one
+(:func:`rigedit.io.atomic.write_json`), so an interrupted batch leaves every entry either as
+it was or complete: never half written, never listed twice (a task's entry is one file named
+by the task). ``OUTDIR/manifest.json`` gathers them all at the end of each run, for people
+and tools; the per-task files are what ``--resume`` reads.
+
+An entry's fields: ``task`` (its id), ``job``, ``input``, ``target`` (a retarget's target
+rig, None otherwise), ``inputs`` (every file read: ``{path: {"hash": "sha256:...",
+"stamp": [size, mtime_ns]}}``), ``settings`` (the job's options), ``rigedit`` (version),
+``outputs`` (paths relative to OUTDIR), ``thumbnail``, ``status`` (``ok`` or ``failed``),
+``error`` (one line), ``failure`` (``error``: the task raised; ``lost``: its worker died
+twice), ``seconds``, ``finished`` (UTC, ISO 8601), ``worker``, ``quality`` (the job's
+figures), ``unsure`` (reasons a person should look), ``warnings``.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+from importlib import metadata
+from pathlib import Path
+
+from ..io.atomic import write_json
+from .inputs import content_hash, quick_stamp
+
+__all__ = ["Manifest", "task_id", "rigedit_version", "MANIFEST_DIR"]
+
+MANIFEST_DIR = "manifest"
+#: An entry file larger than this is not an entry of ours (never read whole).
+MAX_ENTRY_BYTES = 4 << 20
+
+
+def rigedit_version():
+    """The installed rigedit's version (recorded in every entry; a new version re-runs)."""
+    try:
+        return metadata.version("rigedit")
+    except metadata.PackageNotFoundError:
+        return "unknown"
+
+
+def _slug(text, limit=40):
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)[:limit].strip("._") or "task"
+
+
+def task_id(job, source, target=None):
+    """A task's stable id: readable (the input's and target's names) and unique (a hash of
+    the job, the input's full path and the target)."""
+    key = "\0".join([job, str(source), str(target or "")])
+    digest = hashlib.sha1(key.encode()).hexdigest()[:10]
+    name = Path(str(source)).stem + (f"__{Path(str(target)).stem}" if target else "")
+    return f"{job}-{_slug(name)}-{digest}"
+
+
+class Manifest:
+    """The entries of one OUTDIR.
+
+    Parameters
+    ----------
+    outdir : Path
+        The batch's output folder (it exists).
+    """
+
+    def __init__(self, outdir):
+        self.outdir = Path(outdir)
+        self.folder = self.outdir / MANIFEST_DIR
+
+    def path(self, tid):
+        return self.folder / f"{tid}.json"
+
+    def read(self, tid):
+        """The entry of task ``tid``, or None when there is none or it is not one of ours."""
+        return _read_entry(self.path(tid))
+
+    def write(self, entry):
+        """Write ``entry`` atomically (replacing the task's previous entry)."""
+        self.folder.mkdir(exist_ok=True)
+        write_json(self.path(entry["task"]), entry)
+
+    def entries(self):
+        """Every readable entry, sorted by task id."""
+        if not self.folder.is_dir():
+            return []
+        found = (_read_entry(p) for p in sorted(self.folder.glob("*.json")))
+        return [e for e in found if e is not None]
+
+    def write_index(self, job=None):
+        """``OUTDIR/manifest.json``: every entry in one file (rebuilt from the entries)."""
+        entries = self.entries()
+        write_json(self.outdir / "manifest.json",
+                   {"rigedit": rigedit_version(), "job": job, "tasks": entries})
+        return entries
+
+    def done(self, task, version):
+        """True when ``task``'s entry says it succeeded with the same inputs (by content:
+        a file whose size and modification time changed is hashed again), settings, target
+        and rigedit version, and its outputs are all there: ``--resume`` skips it."""
+        entry = self.read(task["id"])
+        if entry is None or entry.get("status") != "ok" or entry.get("rigedit") != version:
+            return False
+        if entry.get("settings") != task["settings"] or entry.get("target") != task["target"]:
+            return False
+        if entry.get("outputs") != task["outputs"]:
+            return False
+        if not all((self.outdir / o).exists() for o in entry["outputs"]):
+            return False
+        recorded = entry.get("inputs") or {}
+        return set(recorded) == set(task["reads"]) and all(
+            _same_content(src, recorded[src]) for src in task["reads"])
+
+
+def _same_content(source, recorded):
+    if not isinstance(recorded, dict):
+        return False
+    stamp = quick_stamp(source)
+    if stamp is None:
+        return False
+    if stamp == recorded.get("stamp"):
+        return True
+    try:
+        return content_hash(source) == recorded.get("hash")
+    except OSError:
+        return False
+
+
+def _read_entry(path):
+    try:
+        if path.stat().st_size > MAX_ENTRY_BYTES:
+            return None
+        entry = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return None
+    if not isinstance(entry, dict) or entry.get("task") != path.stem:
+        return None
+    return entry

@@ -1,0 +1,167 @@
+"""A batch's plan: its options checked, and one task per input (and target), each a plain
+dict a worker receives (paths and settings only, so it pickles small and travels anywhere).
+
+A task: ``id``, ``job``, ``input``, ``target`` (a retarget's rig, else None), ``reads`` (every
+file or bundled name it reads: input, target, template, map), ``settings`` (the job's
+options, as the manifest records them), ``outputs`` (paths relative to OUTDIR), ``thumbnail``
+(relative, or None), ``outdir``.
+"""
+from __future__ import annotations
+
+import hashlib
+import math
+from pathlib import Path
+
+from .inputs import BatchUsageError, rig_source
+from .manifest import task_id
+
+__all__ = ["JOBS", "check_options", "plan", "THUMBS_DIR"]
+
+THUMBS_DIR = "thumbs"
+
+#: Each job's options and their defaults (a key the job does not take is bad input).
+JOBS = {
+    "autorig": {"template": "humanoid", "up": None, "forward": None, "method": "heat",
+                "clips": True, "format": "glb"},
+    "retarget": {"to": None, "map": None, "clip": None, "format": "glb"},
+    "render": {"clip": None, "fps": 24.0, "size": "320x240", "view": "front",
+               "duration": None, "video": "mp4"},
+    "convert": {"to": None, "clip": None},
+    "compress": {"max_error": None},
+    "noop": {},
+}
+#: Options every job takes.
+COMMON = {"thumbnails": True}
+
+_FORMATS = {"glb": ".glb", "folder": "", "bvh": ".bvh"}
+
+
+def _choice(job, key, value, allowed):
+    if value not in allowed:
+        raise BatchUsageError(f"{job} --{key.replace('_', '-')}: expected one of "
+                              f"{', '.join(allowed)}, got {value!r}")
+
+
+def _size(text):
+    try:
+        w, h = (int(v) for v in str(text).lower().split("x"))
+    except ValueError:
+        w = h = 0
+    if not (16 <= w <= 3840 and 16 <= h <= 2160) or w % 2 or h % 2:
+        raise BatchUsageError(f"render --size: expected WIDTHxHEIGHT, even numbers from 16 to "
+                              f"3840x2160, got {text!r}")
+    return w, h
+
+
+def _positive(job, key, value, high):
+    if value is None:
+        return None
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and 0 < value <= high):
+        raise BatchUsageError(f"{job} --{key.replace('_', '-')}: expected a number in (0, "
+                              f"{high:g}], got {value!r}")
+    return float(value)
+
+
+def check_options(job, options):
+    """The job's settings: its defaults updated by ``options``, checked.
+
+    Raises
+    ------
+    BatchUsageError
+        An unknown job or option, or a value that makes no sense (naming it).
+    """
+    if job not in JOBS:
+        raise BatchUsageError(f"expected a job ({', '.join(j for j in JOBS if j != 'noop')}), "
+                              f"got {job!r}")
+    known = {**JOBS[job], **COMMON}
+    unknown = sorted(set(options) - set(known))
+    if unknown:
+        raise BatchUsageError(f"{job}: unknown option{'s' if len(unknown) > 1 else ''} "
+                              f"{', '.join(unknown)} (it takes {', '.join(sorted(known))})")
+    s = {**known, **{k: v for k, v in options.items() if v is not None}}
+    if job == "autorig":
+        s["template"] = rig_source(s["template"])
+        _choice(job, "method", s["method"], ("heat", "idw"))
+        _choice(job, "format", s["format"], ("glb", "folder"))
+    elif job == "retarget":
+        targets = s["to"] if isinstance(s["to"], (list, tuple)) else [s["to"]] * bool(s["to"])
+        if not targets:
+            raise BatchUsageError("retarget: expected at least one target rig (--to RIG)")
+        s["to"] = sorted({rig_source(t) for t in targets})
+        if s["map"] is not None:
+            s["map"] = rig_source(s["map"])
+        _choice(job, "format", s["format"], ("glb", "folder"))
+    elif job == "render":
+        if not s["clip"]:
+            raise BatchUsageError("render: expected the clip to render (--clip NAME)")
+        _size(s["size"])
+        s["fps"] = _positive(job, "fps", s["fps"], 240)
+        s["duration"] = _positive(job, "duration", s["duration"], 3600)
+        _choice(job, "view", s["view"], ("front", "side", "back", "top"))
+        _choice(job, "video", s["video"], ("mp4", "gif"))
+    elif job == "convert":
+        _choice(job, "to", s["to"], tuple(_FORMATS))
+    elif job == "compress":
+        s["max_error"] = _positive(job, "max_error", s["max_error"], 100)
+        if s["max_error"] is None:
+            raise BatchUsageError("compress: expected --max-error CM")
+    return s
+
+
+def _outputs(job, base, settings):
+    """Output names (relative to OUTDIR) of one task whose outputs are called ``base``."""
+    if job in ("autorig", "retarget"):
+        return [base + _FORMATS[settings["format"]]]
+    if job == "render":
+        name = f"{base}_{settings['clip']}"
+        return [f"{name}.{settings['video']}", f"{name}_sheet.png"]
+    if job == "convert":
+        return [base + _FORMATS[settings["to"]]]
+    if job == "compress":
+        return [base + ".glb"]
+    return []
+
+
+def _pairs(job, sources, settings):
+    if job == "retarget":
+        return [(s, t) for s in sources for t in settings["to"]]
+    return [(s, None) for s in sources]
+
+
+def _unique_bases(pairs):
+    """An output base name per pair: the input's stem (and the target's); a name two inputs
+    share gets a short hash of the input's path, so no task overwrites another's output."""
+    bases = [Path(str(s)).stem + (f"__{Path(str(t)).stem}" if t else "") for s, t in pairs]
+    seen = {}
+    for b in bases:
+        seen[b] = seen.get(b, 0) + 1
+    return [b if seen[b] == 1 else f"{b}-{hashlib.sha1(str(s).encode()).hexdigest()[:6]}"
+            for b, (s, _) in zip(bases, pairs)]
+
+
+def plan(job, sources, outdir, settings):
+    """One task dict per input (a retarget: per input and target), in input order.
+
+    Parameters
+    ----------
+    job : str
+    sources : list of Path or str
+        :func:`rigedit.batch.inputs.expand_inputs`'s list.
+    outdir : Path
+    settings : dict
+        :func:`check_options`'s result.
+    """
+    pairs = _pairs(job, sources, settings)
+    tasks = []
+    for (source, target), base in zip(pairs, _unique_bases(pairs)):
+        tid = task_id(job, source, target)
+        reads = [str(source)] + ([target] if target else [])
+        reads += [settings[k] for k in ("template", "map") if settings.get(k)]
+        task_settings = {k: v for k, v in settings.items() if k != "to" or job != "retarget"}
+        outputs = _outputs(job, base, settings)
+        thumb = outputs[1] if job == "render" else (
+            f"{THUMBS_DIR}/{tid}.gif" if settings["thumbnails"] and job != "noop" else None)
+        tasks.append({"id": tid, "job": job, "input": str(source), "target": target,
+                      "reads": reads, "settings": task_settings, "outputs": outputs,
+                      "thumbnail": thumb, "outdir": str(outdir)})
+    return tasks
