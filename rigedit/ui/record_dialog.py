@@ -130,6 +130,7 @@ class RecordDialog(QtWidgets.QDialog):
         self.fps_spin.setRange(1, 120)
         self.fps_spin.setValue(30)
         form.addRow("Frame rate", self.fps_spin)
+        self.clip_end = clip.duration if clip is not None else None
         self.start_spin, self.end_spin = QtWidgets.QDoubleSpinBox(), QtWidgets.QDoubleSpinBox()
         for s, v in ((self.start_spin, 0.0), (self.end_spin, end)):
             s.setRange(0.0, 3600.0)
@@ -168,11 +169,19 @@ class RecordDialog(QtWidgets.QDialog):
             self.path_edit.setText(path)
 
     def settings(self):
-        """Keyword arguments for :func:`record_video`."""
+        """Keyword arguments for :func:`record_video`; ``ValueError`` for a time range that
+        is empty or starts past the clip's end (past the end, a looping clip plays again
+        from its start and another holds its last pose, as ``rigedit render --end``)."""
         start, end = self.start_spin.value(), self.end_spin.value()
+        if end <= start:
+            raise ValueError(f"Time range: expected an end after the start ({start:g} s), "
+                             f"got {end:g} s")
+        if self.clip_end and start >= self.clip_end:
+            raise ValueError(f"Time range: the start ({start:g} s) is past the clip's end "
+                             f"({self.clip_end:g} s)")
         return {"path": self.path_edit.text().strip(), "fps": self.fps_spin.value(),
                 "size": (self.width_spin.value(), self.height_spin.value()), "start": start,
-                "duration": max(end - start, 1.0 / self.fps_spin.value()),
+                "duration": end - start,
                 "camera": "orbit" if self.orbit_radio.isChecked() else "view",
                 "orbit": self.orbit_spin.value(), "follow_root": self.follow_box.isChecked()}
 
@@ -206,8 +215,8 @@ class RecordVideo:
         dialog = RecordDialog(self.document, self.services.parent)
         if dialog.exec_() != QtWidgets.QDialog.Accepted:
             return 0
-        kwargs = dialog.settings()
         try:
+            kwargs = dialog.settings()
             return self.record(kwargs.pop("path"), **kwargs)
         except (RigFileError, ValueError, OSError) as exc:
             self.services.error("Export video", str(exc))
