@@ -288,26 +288,36 @@ def _animations(w, rig, joints, clips, mesh_node=None):
         if name not in rig.clips:
             raise KeyError(f"unknown clip {name!r} (the rig has {', '.join(rig.clips) or 'none'})")
     for name in names:
-        clip = rig.clips[name]
-        samplers, channels = [], []
-        for (joint, channel), tr in clip.tracks.items():
-            if np.any(tr.times < 0):
-                raise ValueError(f"clip {name!r}: glTF key times must be >= 0, got "
-                                 f"{tr.times.min():g} on {joint!r} {channel}")
-            samplers.append(_track_sampler(w, tr))
-            channels.append({"sampler": len(samplers) - 1,
-                             "target": {"node": joints[clip.skeleton.index[joint]],
-                                        "path": channel}})
-        _weights_channel(w, rig, clip, mesh_node, samplers, channels)
-        if channels:
-            w.add("animations", {"name": name, "samplers": samplers, "channels": channels,
-                                 "extras": {"rigedit": {"duration": clip.duration,
-                                                        "loop": clip.loop}}})
+        clip_animation(w, rig, name, rig.clips[name], joints, mesh_node, _track_sampler)
 
 
-def gltf_bytes(rig, binary=True, clips=None):
+def clip_animation(w, rig, name, clip, joints, mesh_node, sampler):
+    """Add one clip's animation: a channel per track whose ``sampler(w, track)`` gives a
+    sampler dict (None leaves the track out), the morph weights, duration and loop."""
+    samplers, channels = [], []
+    for (joint, channel), tr in clip.tracks.items():
+        if np.any(tr.times < 0):
+            raise ValueError(f"clip {name!r}: glTF key times must be >= 0, got "
+                             f"{tr.times.min():g} on {joint!r} {channel}")
+        got = sampler(w, tr)
+        if got is None:
+            continue
+        samplers.append(got)
+        channels.append({"sampler": len(samplers) - 1,
+                         "target": {"node": joints[clip.skeleton.index[joint]],
+                                    "path": channel}})
+    _weights_channel(w, rig, clip, mesh_node, samplers, channels)
+    if channels:
+        w.add("animations", {"name": name, "samplers": samplers, "channels": channels,
+                             "extras": {"rigedit": {"duration": clip.duration,
+                                                    "loop": clip.loop}}})
+
+
+def gltf_bytes(rig, binary=True, clips=None, compact=None):
     """The file's bytes: GLB when ``binary``, else glTF JSON with an embedded buffer; ``rig``
-    is a :class:`~rigedit.io.data.RigData` (a Rig gives its ``data()``)."""
+    is a :class:`~rigedit.io.data.RigData` (a Rig gives its ``data()``). ``compact``, a
+    :class:`~rigedit.io.gltf_write_compact.CompactAnimations`, writes compressed clips instead
+    of the rig's (and may rewrite the buffers, meshopt)."""
     rig = as_rig_data(rig)
     w = _Writer()
     mesh = _mesh(w, rig)
@@ -323,9 +333,14 @@ def gltf_bytes(rig, binary=True, clips=None):
         scene.insert(0, mesh_node)
     w.doc["scenes"] = [{"nodes": scene}]
     w.doc["scene"] = 0
-    _animations(w, rig, joints, clips, mesh_node)
+    if compact is None:
+        _animations(w, rig, joints, clips, mesh_node)
+    else:
+        compact.write(w, rig, joints, mesh_node)
     w.blob += bytes((-len(w.blob)) % 4)
     w.doc["buffers"] = [{"byteLength": len(w.blob)}]
+    if compact is not None:
+        compact.finish(w)
     if not binary:
         w.doc["buffers"][0]["uri"] = ("data:application/octet-stream;base64,"
                                       + base64.b64encode(bytes(w.blob)).decode("ascii"))
@@ -337,7 +352,7 @@ def gltf_bytes(rig, binary=True, clips=None):
     return b"glTF" + struct.pack("<II", 2, 12 + len(body)) + body
 
 
-def save_gltf(rig, path, clips=None):
+def save_gltf(rig, path, clips=None, compact=None):
     """Write ``rig`` as glTF 2.0, atomically.
 
     Parameters
@@ -348,6 +363,8 @@ def save_gltf(rig, path, clips=None):
         ``.glb`` (binary) or ``.gltf`` (JSON with the buffer embedded as a data URI).
     clips : list[str], optional
         Names of the clips to write; all when None.
+    compact : CompactAnimations, optional
+        Compressed clips to write instead (:mod:`rigedit.io.gltf_write_compact`).
 
     Raises
     ------
@@ -359,7 +376,7 @@ def save_gltf(rig, path, clips=None):
     if suffix not in (".glb", ".gltf"):
         raise RigFileError(path, f"expected a .glb or .gltf file name, got {suffix or 'none'!r}")
     try:
-        data = gltf_bytes(rig, binary=suffix == ".glb", clips=clips)
+        data = gltf_bytes(rig, binary=suffix == ".glb", clips=clips, compact=compact)
     except (KeyError, ValueError) as exc:
         raise RigFileError(path, str(exc).strip("'\"")) from None
     with atomic_write(path, "wb", suffix=suffix) as fh:
