@@ -46,3 +46,26 @@ def run_cli(*args, timeout=240, env=None):
 def litter(outdir):
     """Hidden files and folders (writers' temporaries) anywhere under ``outdir``."""
     return sorted(p for p in Path(outdir).rglob(".*"))
+
+
+def free_port():
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def run_in_process(root, count=2, thumbnails=False):
+    """``count`` motions and a broken file retargeted onto the humanoid by
+    :func:`rigedit.batch.jobs.run_task` in this process (no cluster): ``(out, tasks,
+    entries)``; OUTDIR is ``root / "out"``."""
+    from rigedit.batch.jobs import run_task
+    from rigedit.batch.tasks import check_options, plan
+
+    motions = make_motions(root / "in", count) + [broken_bvh(root / "in")]
+    out = root / "out"
+    out.mkdir()
+    settings = check_options("retarget", {"to": ["humanoid"], "thumbnails": thumbnails})
+    tasks = plan("retarget", motions, out, settings)
+    return out, tasks, [run_task(t) for t in tasks]

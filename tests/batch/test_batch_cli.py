@@ -1,19 +1,12 @@
 """``rigedit batch``: exit 2 for bad input before any work, exit 1 with a failed row for a
 broken file among good ones, and a resumed run that does nothing."""
 import json
-import socket
 
 import pytest
 
 import rigedit
-from batch_helpers import broken_bvh, litter, make_motions, run_cli
+from batch_helpers import free_port, broken_bvh, litter, make_motions, run_cli
 from rigedit.cli.main import main
-
-
-def _free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 @pytest.mark.parametrize("args, message", [
@@ -46,7 +39,7 @@ def test_a_scheduler_that_does_not_answer_exits_2_within_seconds(tmp_path, capsy
     out = tmp_path / "out"
     t0 = time.perf_counter()
     code = main(["batch", "convert", "humanoid", "--to", "glb", "-o", str(out),
-                 "--scheduler", f"tcp://127.0.0.1:{_free_port()}", "--timeout", "1"])
+                 "--scheduler", f"tcp://127.0.0.1:{free_port()}", "--timeout", "1"])
     assert code == 2 and time.perf_counter() - t0 < 15
     assert "does not answer within 1 s" in capsys.readouterr().err
     assert not out.exists()

@@ -14,16 +14,10 @@ from pathlib import Path
 import pytest
 
 import rigedit
-from batch_helpers import RIGEDIT, litter, make_motions, run_cli
+from batch_helpers import free_port, RIGEDIT, litter, make_motions, run_cli
 from testpaths import REPO
 
 DASK = str(Path(sys.executable).parent / "dask")
-
-
-def _free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def _wait_port(port, proc, seconds=30):
@@ -41,7 +35,7 @@ def _wait_port(port, proc, seconds=30):
 def cluster():
     env = {**os.environ, "OMP_NUM_THREADS": "1",
            "DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "1"}
-    port = _free_port()
+    port = free_port()
     address = f"tcp://127.0.0.1:{port}"
     quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
     procs = [subprocess.Popen([DASK, "scheduler", "--host", "127.0.0.1", "--port", str(port),

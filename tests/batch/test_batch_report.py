@@ -7,10 +7,8 @@ import subprocess
 
 import pytest
 
-from batch_helpers import broken_bvh, make_motions
-from rigedit.batch.jobs import run_task
+from batch_helpers import run_in_process
 from rigedit.batch.report import write_report
-from rigedit.batch.tasks import check_options, plan
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="needs chromium (python3 dev.py "
@@ -20,12 +18,7 @@ pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="needs chromium (python
 @pytest.fixture(scope="module")
 def report(tmp_path_factory):
     """Two retargets with thumbnails, one of them made unsure, and a broken input."""
-    root = tmp_path_factory.mktemp("report")
-    motions = make_motions(root / "in", 2) + [broken_bvh(root / "in")]
-    out = root / "out"
-    out.mkdir()
-    tasks = plan("retarget", motions, out, check_options("retarget", {"to": ["humanoid"]}))
-    entries = [run_task(t) for t in tasks]
+    out, _, entries = run_in_process(tmp_path_factory.mktemp("report"), thumbnails=True)
     entries[1]["unsure"] = ["unmapped: left arm"]   # as a partial map gives
     return write_report(out, "retarget", entries), entries
 

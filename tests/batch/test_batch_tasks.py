@@ -5,9 +5,8 @@ import os
 import pytest
 
 import rigedit
-from batch_helpers import broken_bvh, make_motions
+from batch_helpers import run_in_process
 from rigedit.batch.inputs import BatchUsageError
-from rigedit.batch.jobs import run_task
 from rigedit.batch.manifest import Manifest, rigedit_version
 from rigedit.batch.tasks import check_options, plan
 
@@ -15,14 +14,8 @@ from rigedit.batch.tasks import check_options, plan
 @pytest.fixture(scope="module")
 def ran(tmp_path_factory):
     """Two motions and a broken file retargeted onto the humanoid, entries written."""
-    root = tmp_path_factory.mktemp("batch")
-    motions = make_motions(root / "in", 2) + [broken_bvh(root / "in")]
-    out = root / "out"
-    out.mkdir()
-    settings = check_options("retarget", {"to": ["humanoid"], "thumbnails": False})
-    tasks = plan("retarget", motions, out, settings)
+    out, tasks, entries = run_in_process(tmp_path_factory.mktemp("batch"))
     manifest = Manifest(out)
-    entries = [run_task(t) for t in tasks]
     for e in entries:
         manifest.write(e)
     return out, tasks, entries, manifest
