@@ -152,6 +152,12 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         scene = RigScene(plotter, rig, show_skeleton=show_skeleton, show_floor=show_floor,
                          skinning=skinning, skinned_normals=True, floor_style="lines")
         _grid_floor(plotter)
+        follow = figure_joints(rig, clip)[1]   # the hips, not a carrier root left behind
+        if scene.floor is not None and clip is not None:
+            # a floor under the whole travel, fixed, so the camera following the figure
+            # shows it walking over the lines
+            scene.floor.following = False
+            scene.floor.reach(_travel(rig, clip, times, follow))
         pose = rig.rest_pose()
         if camera is not None:
             apply_camera(plotter.camera, camera)
@@ -163,7 +169,6 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         model0 = scene.update(pose)
         base_pos = np.array(plotter.camera.position)
         base_focal = np.array(plotter.camera.focal_point)
-        follow = figure_joints(rig, clip)[1]   # the hips, not a carrier root left behind
         root0 = model0[follow, :3, 3].copy()
         up = scene.up
         camera = plotter.camera
@@ -204,6 +209,16 @@ def record_clip(rig, clip, path, fps=30, duration=None, size=(1280, 720), start=
         if writer is not None:
             writer.abort()
         plotter.close()
+
+
+def _travel(rig, clip, times, joint, samples=200):
+    """(N, 3) positions of ``joint`` over the recorded ``times`` (at most ``samples`` of
+    them, first and last included): where the figure goes."""
+    pose = rig.rest_pose()
+    pick = np.unique(np.linspace(0, len(times) - 1, min(samples, len(times))).round()
+                     .astype(int))
+    return np.array([rig.joint_matrices(clip.sample(times[i], out=pose))[joint, :3, 3]
+                     for i in pick])
 
 
 def _frame_callback(progress):

@@ -14,8 +14,9 @@ from vtkmodules.vtkFiltersCore import vtkPolyDataNormals
 
 from ..model.kinematics import skinning_matrices
 from . import mesh_look
-from .camera import frame_view, front_vector, rest_points, up_vector
-from .floor import add_floor
+from ..model.carrier import figure_root
+from .camera import figure_joints, frame_view, front_vector, rest_points, up_vector
+from .floor import Floor
 from .proxy import ProxyActor, faces_to_vtk, write_skin
 from .skeleton_actors import BareSkeleton, add_bones
 
@@ -92,7 +93,12 @@ class RigScene:
         self.bone_actor.SetVisibility(show_skeleton or not self.has_mesh)
         #: The joint balls and tails of a rig with no mesh, or None
         self.bare_skeleton = None if self.has_mesh else BareSkeleton(plotter, rig)
-        self.floor_actor = self._add_floor(floor_style) if show_floor else None
+        #: The :class:`~rigedit.render.floor.Floor`, or None; it follows the figure's root
+        #: (the hips below any carrier root) in whole cells as the pose moves
+        self.floor = self._add_floor(floor_style) if show_floor else None
+        self.floor_actor = None if self.floor is None else self.floor.grid_actor
+        self._floor_joint = figure_root(sk.parents, figure_joints(rig)[0]) if show_floor \
+            else 0
         self.display_mode = "solid"
         self.weights_shown = False
         self._weight_lut = None
@@ -177,8 +183,8 @@ class RigScene:
 
     def _add_floor(self, style):
         points = self.rest_points()
-        return add_floor(self.plotter, points.min(axis=0), points.max(axis=0),
-                         1 if self.rig.up == "y" else 2, self.up, style=style)
+        return Floor(self.plotter, points.min(axis=0), points.max(axis=0),
+                     1 if self.rig.up == "y" else 2, self.up, style=style)
 
     def set_skeleton_visible(self, visible):
         self.bone_actor.SetVisibility(bool(visible))
@@ -294,6 +300,8 @@ class RigScene:
             else:
                 write_skin(self.mesh, self.rig.binding.skin(palette, method=self.skinning))
         self.joint_positions[:] = model[:, :3, 3]
+        if self.floor is not None:
+            self.floor.follow(self.joint_positions[self._floor_joint])
         self.bones.points[:] = self.joint_positions
         self.bones.GetPoints().Modified()
         self.bones.Modified()
