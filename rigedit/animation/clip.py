@@ -6,6 +6,7 @@ import numpy as np
 
 from ..model.pose import Pose
 from .clip_names import check_clip_name
+from .curve_pack import BezierTracks
 from .morph_track import WeightTrack
 from .track import CHANNELS, DEFAULT_MODE, KEY_TOLERANCE, Track
 
@@ -40,6 +41,7 @@ class Clip:
         self.morph_tracks = {}
         self.loop = bool(loop)
         self.revision = 0
+        self._bezier = None   # (revision, BezierTracks): the bezier tracks packed for sample
         for (joint, channel), track in (tracks or {}).items():
             self.set_track(joint, channel, track)
         for target, track in (morph_tracks or {}).items():
@@ -266,9 +268,22 @@ class Clip:
             pose.reset()
         t = self.local_time(t)
         index = self.skeleton.index
+        bezier = self.bezier_tracks()
         for (joint, channel), track in self.tracks.items():
-            getattr(pose, channel)[index[joint]] = track.sample(t)
+            if track.curves is None:
+                getattr(pose, channel)[index[joint]] = track.sample(t)
+        if len(bezier):
+            for (joint, channel), value in bezier.sample(t):
+                getattr(pose, channel)[index[joint]] = value
         return pose
+
+    def bezier_tracks(self):
+        """The clip's bezier tracks packed for sampling them in one call
+        (:class:`~rigedit.animation.curve_pack.BezierTracks`), rebuilt when :attr:`revision`
+        changed."""
+        if self._bezier is None or self._bezier[0] != self.revision:
+            self._bezier = (self.revision, BezierTracks(self.tracks))
+        return self._bezier[1]
 
     def copy(self, name=None):
         return Clip(name or self.name, self.skeleton,

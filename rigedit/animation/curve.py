@@ -1,0 +1,498 @@
+"""Bezier curves of one scalar channel: keys with per-key interpolation and handles, as in
+Blender's F-curves.
+
+A :class:`Curve` holds K keys. Key ``k``'s interpolation names how the segment from key ``k``
+to key ``k + 1`` is drawn (``constant``: hold, ``linear``, ``bezier``); the last key's is
+unused. Every key has an in-handle (``left``) and an out-handle (``right``): absolute
+``(time, value)`` points with a type each:
+
+``auto``          smooth: the slope of the line through the two neighbours (Catmull-Rom-like),
+                  each handle a third of its segment long in time
+``auto_clamped``  as ``auto``, but flat at a key that is a local extreme and shortened so the
+                  handles stay within the values of the keys either side: the segment then
+                  never overshoots its keys (the default for new keys, as in Blender)
+``aligned``       placed by the user; dragging one turns the other to stay collinear
+``free``          placed by the user, independent
+``vector``        pointing a third of the way to the neighbouring key
+================  ==========================================================================
+
+The end keys' automatic handles are flat (the curve holds its end values beyond the keys, as
+Blender does with constant extrapolation). Handles' time extents are clamped so each segment
+stays a function of time: a left handle is never after its key, a right one never before,
+and when a segment's two handles together reach further than the segment is long both are
+scaled down in proportion (Blender's ``BKE_fcurve_correct_bezpart``), so ``x(u)`` is monotone
+and ``x(u) = t`` has one root, found by a few safeguarded Newton steps on all samples at once.
+
+Curves are immutable: edits return new curves (automatic handles recomputed).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["INTERPOLATIONS", "HANDLE_TYPES", "EASINGS", "AUTO_TYPES", "Curve",
+           "bezier_points", "solve_u", "ONE_KEY_HANDLE"]
+
+INTERPOLATIONS = ("constant", "linear", "bezier")
+HANDLE_TYPES = ("auto", "auto_clamped", "aligned", "free", "vector")
+EASINGS = ("ease_in", "ease_out", "ease_in_out")
+#: Types whose handles the curve places itself (recomputed after every edit).
+AUTO_TYPES = ("auto", "auto_clamped", "vector")
+#: Time length (seconds) of the handles of a key without neighbours.
+ONE_KEY_HANDLE = 1.0 / 3.0
+#: Easing presets make the eased handle this fraction of its segment long (flat).
+EASE_LENGTH = 0.6
+
+
+def _names(values, allowed, count, what, default):
+    if values is None:
+        return np.array([default] * count, dtype=object)
+    if isinstance(values, str):
+        values = [values] * count
+    out = np.array(list(values), dtype=object)
+    if out.shape != (count,):
+        raise ValueError(f"curve: expected {count} {what} names, got {out.shape[0]}")
+    bad = [v for v in out if v not in allowed]
+    if bad:
+        raise ValueError(f"curve: expected {what} in {allowed}, got {bad[0]!r}")
+    return out
+
+
+class Curve:
+    """One scalar channel: K keys, per-key interpolation, Bezier handles (Blender's model).
+
+    Parameters
+    ----------
+    times : (K,) float
+        Seconds, strictly increasing.
+    values : (K,) float
+        Metres, scale factors, or degrees for Euler rotations.
+    interpolation : (K,) str or str, optional
+        From :data:`INTERPOLATIONS`; ``bezier`` when omitted.
+    left, right : (K, 2) float, optional
+        Absolute ``(time, value)`` of each key's in- and out-handle; computed for automatic
+        types (and flat, a third of the segment, when omitted).
+    left_type, right_type : (K,) str or str, optional
+        From :data:`HANDLE_TYPES`; ``auto_clamped`` when omitted.
+    """
+
+    __slots__ = ("times", "values", "interpolation", "left", "right", "left_type",
+                 "right_type", "_segments")
+
+    def __init__(self, times, values, interpolation=None, left=None, right=None,
+                 left_type=None, right_type=None):
+        times = np.array(times, dtype=np.float64).reshape(-1)
+        values = np.array(values, dtype=np.float64).reshape(-1)
+        k = len(times)
+        if k == 0:
+            raise ValueError("curve: expected at least one key, got none")
+        if values.shape != (k,):
+            raise ValueError(f"curve: expected {k} values, got {values.shape[0]}")
+        if not (np.all(np.isfinite(times)) and np.all(np.isfinite(values))):
+            raise ValueError("curve: expected finite key times and values, got NaN or inf")
+        if np.any(np.diff(times) <= 0):
+            raise ValueError("curve: expected strictly increasing key times")
+        self.times, self.values = times, values
+        self.interpolation = _names(interpolation, INTERPOLATIONS, k, "interpolation",
+                                    "bezier")
+        self.left_type = _names(left_type, HANDLE_TYPES, k, "handle type", "auto_clamped")
+        self.right_type = _names(right_type, HANDLE_TYPES, k, "handle type", "auto_clamped")
+        flat_l, flat_r = self._flat_handles()
+        self.left = self._points(left, flat_l, "left")
+        self.right = self._points(right, flat_r, "right")
+        self._place_handles()
+        self._segments = None
+        for a in ("times", "values", "left", "right"):
+            getattr(self, a).flags.writeable = False
+
+    # ------------------------------------------------------------------ handles
+    def _spans(self):
+        """(K,) time spans before and after each key (the other side's at an end key)."""
+        if len(self.times) == 1:
+            one = np.array([ONE_KEY_HANDLE])
+            return one, one
+        dt = np.diff(self.times)
+        return np.r_[dt[0], dt], np.r_[dt, dt[-1]]
+
+    def _flat_handles(self):
+        before, after = self._spans()
+        return (np.stack([self.times - before / 3, self.values], axis=1),
+                np.stack([self.times + after / 3, self.values], axis=1))
+
+    def _points(self, given, default, side):
+        if given is None:
+            return default
+        pts = np.array(given, dtype=np.float64)
+        if pts.shape != default.shape:
+            raise ValueError(f"curve: expected {side} handles of shape {default.shape}, got "
+                             f"{pts.shape}")
+        if not np.all(np.isfinite(pts)):
+            raise ValueError(f"curve: expected finite {side} handles, got NaN or inf")
+        # a function of time: the in-handle not after its key, the out-handle not before
+        pts[:, 0] = np.minimum(pts[:, 0], self.times) if side == "left" else \
+            np.maximum(pts[:, 0], self.times)
+        return pts
+
+    def auto_slopes(self, clamped):
+        """(K,) value-per-second slopes of the automatic handles: the neighbours' secant
+        (``auto``), flattened at extremes and limited so the handles stay within the
+        neighbouring keys' values (``clamped``); 0 at the end keys."""
+        t, v = self.times, self.values
+        m = np.zeros(len(t))
+        if len(t) < 3:
+            return m
+        dv_a, dv_b = v[1:-1] - v[:-2], v[2:] - v[1:-1]
+        dt_a, dt_b = t[1:-1] - t[:-2], t[2:] - t[1:-1]
+        inner = (v[2:] - v[:-2]) / (t[2:] - t[:-2])
+        if clamped:
+            extreme = dv_a * dv_b <= 0
+            # a handle a third of the span long reaches m * span / 3: within the key's
+            # neighbour when |m| <= 3 |dv| / span, on both sides
+            limit = np.minimum(3 * np.abs(dv_a) / dt_a, 3 * np.abs(dv_b) / dt_b)
+            inner = np.where(extreme, 0.0, np.clip(inner, -limit, limit))
+        m[1:-1] = inner
+        return m
+
+    def _place_handles(self):
+        """Recompute the automatic (auto, auto_clamped, vector) handles in place."""
+        t, v = self.times, self.values
+        before, after = self._spans()
+        slope = {"auto": self.auto_slopes(False), "auto_clamped": self.auto_slopes(True)}
+        prev_v = np.r_[v[0], v[:-1]]
+        next_v = np.r_[v[1:], v[-1]]
+        for side, types, span, sign, other in (("left", self.left_type, before, -1, prev_v),
+                                               ("right", self.right_type, after, 1, next_v)):
+            pts = getattr(self, side)
+            for name, m in slope.items():
+                mask = types == name
+                pts[mask, 0] = t[mask] + sign * span[mask] / 3
+                pts[mask, 1] = v[mask] + sign * m[mask] * span[mask] / 3
+            mask = types == "vector"
+            pts[mask, 0] = t[mask] + sign * span[mask] / 3
+            pts[mask, 1] = v[mask] + (other[mask] - v[mask]) / 3
+
+    # ------------------------------------------------------------------ sampling
+    def __len__(self):
+        return len(self.times)
+
+    def segments(self):
+        """The control points of every segment, cached: ``(K - 1, 4, 2)`` per segment, key,
+        out-handle, in-handle, key, with the handles' time extents corrected (see the module
+        notes)."""
+        if self._segments is None:
+            codes = np.array([INTERPOLATIONS.index(n) for n in self.interpolation], np.int8)
+            self._segments = (bezier_points(self.times, self.values, self.left, self.right),
+                              codes)
+        return self._segments[0]
+
+    def codes(self):
+        """(K,) int8 index of each key's interpolation in :data:`INTERPOLATIONS` (cached)."""
+        self.segments()
+        return self._segments[1]
+
+    def sample(self, t):
+        """Value(s) at time(s) ``t`` (scalar or (N,)), clamped to the first and last key."""
+        scalar = np.ndim(t) == 0
+        t = np.clip(np.asarray(t, dtype=np.float64).reshape(-1), self.times[0], self.times[-1])
+        out = self._sample(t)
+        return float(out[0]) if scalar else out
+
+    def _sample(self, t):
+        k = len(self.times)
+        if k == 1:
+            return np.full(len(t), self.values[0])
+        i = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, k - 2)
+        return evaluate(self.segments()[i], self.codes()[i], t)
+
+    # ------------------------------------------------------------------ edits
+    def _replace(self, **fields):
+        names = ("times", "values", "interpolation", "left", "right", "left_type",
+                 "right_type")
+        args = {n: fields.get(n, getattr(self, n)) for n in names}
+        return Curve(**args)
+
+    def with_keys_moved(self, indices, dt, dv):
+        """The keys ``indices`` moved by ``dt`` seconds and ``dv`` units, their handles with
+        them (same offsets).
+
+        A key is not passed over its neighbour: the move's time offset is clamped so every
+        moved key stays more than :data:`MIN_GAP` from the unmoved keys (all moved keys by
+        the same clamped offset, so their order and spacing are kept).
+        """
+        idx = np.unique(np.asarray(indices, dtype=int).reshape(-1))
+        if len(idx) == 0:
+            return self
+        dt = _clamp_shift(self.times, idx, float(dt))
+        times, values = self.times.copy(), self.values.copy()
+        left, right = self.left.copy(), self.right.copy()
+        times[idx] += dt
+        values[idx] += dv
+        for pts in (left, right):
+            pts[idx, 0] += dt
+            pts[idx, 1] += dv
+        return self._replace(times=times, values=values, left=left, right=right)
+
+    def with_handle(self, index, side, point):
+        """Key ``index``'s ``side`` (``left``/``right``) handle at ``point`` (time, value).
+
+        An automatic handle that is dragged becomes ``aligned`` (both sides, as Blender does);
+        an aligned handle's other side turns to stay collinear, keeping its length; a free
+        handle moves alone. The time is clamped to the key's side.
+        """
+        if side not in ("left", "right"):
+            raise ValueError(f"curve: expected side 'left' or 'right', got {side!r}")
+        i = int(index)
+        other = "right" if side == "left" else "left"
+        lt, rt = self.left_type.copy(), self.right_type.copy()
+        types = {"left": lt, "right": rt}
+        if types[side][i] in AUTO_TYPES:
+            types[side][i] = "aligned"
+            if types[other][i] in AUTO_TYPES:
+                types[other][i] = "aligned"
+        pts = {"left": self.left.copy(), "right": self.right.copy()}
+        key = np.array([self.times[i], self.values[i]])
+        p = np.array(point, dtype=np.float64).reshape(2)
+        p[0] = min(p[0], key[0]) if side == "left" else max(p[0], key[0])
+        pts[side][i] = p
+        if types[side][i] == "aligned" and types[other][i] == "aligned":
+            d = key - p
+            n = np.hypot(*d)
+            length = np.hypot(*(pts[other][i] - key))
+            if n > 1e-12:
+                pts[other][i] = key + d / n * length
+        return self._replace(left=pts["left"], right=pts["right"], left_type=lt, right_type=rt)
+
+    def with_key(self, t, value=None):
+        """A key inserted at ``t`` (``value``: the curve's value there when None; a key already
+        within 1e-9 s of ``t`` takes the value instead). New keys are bezier, auto_clamped."""
+        t = float(t)
+        v = self.sample(t) if value is None else float(value)
+        near = np.flatnonzero(np.abs(self.times - t) <= 1e-9)
+        if len(near):
+            return self.with_keys_moved(near, 0.0, v - self.values[near[0]])
+        j = int(np.searchsorted(self.times, t))
+        flat = np.array([t, v])
+
+        def ins(a, x):
+            return np.insert(a, j, x, axis=0)
+
+        return Curve(ins(self.times, t), ins(self.values, v),
+                     ins(self.interpolation, "bezier"), ins(self.left, flat),
+                     ins(self.right, flat), ins(self.left_type, "auto_clamped"),
+                     ins(self.right_type, "auto_clamped"))
+
+    def without_keys(self, indices):
+        """The curve without keys ``indices``; None when no key is left."""
+        keep = np.ones(len(self.times), dtype=bool)
+        keep[np.asarray(indices, dtype=int)] = False
+        if not keep.any():
+            return None
+        return Curve(self.times[keep], self.values[keep], self.interpolation[keep],
+                     self.left[keep], self.right[keep], self.left_type[keep],
+                     self.right_type[keep])
+
+    def with_interpolation(self, indices, name):
+        """Keys ``indices``' segments (to the next key) drawn as ``name``."""
+        interp = self.interpolation.copy()
+        interp[np.asarray(indices, dtype=int)] = name
+        return self._replace(interpolation=interp)
+
+    def with_handle_type(self, indices, name, side="both"):
+        """Handle type ``name`` on keys ``indices`` (``side``: left, right or both)."""
+        idx = np.asarray(indices, dtype=int)
+        lt, rt = self.left_type.copy(), self.right_type.copy()
+        if side in ("left", "both"):
+            lt[idx] = name
+        if side in ("right", "both"):
+            rt[idx] = name
+        return self._replace(left_type=lt, right_type=rt)
+
+    def with_easing(self, indices, name):
+        """An easing preset on keys ``indices``: ``ease_in`` makes the in-handle flat and
+        long (:data:`EASE_LENGTH` of its segment: the curve arrives slowly), ``ease_out``
+        the out-handle, ``ease_in_out`` both. The eased handles become ``free`` (the other
+        side keeps its type) and their segments bezier."""
+        if name not in EASINGS:
+            raise ValueError(f"curve: expected an easing in {EASINGS}, got {name!r}")
+        idx = np.asarray(indices, dtype=int).reshape(-1)
+        before, after = self._spans()
+        left, right = self.left.copy(), self.right.copy()
+        lt, rt = self.left_type.copy(), self.right_type.copy()
+        interp = self.interpolation.copy()
+        t, v = self.times[idx], self.values[idx]
+        if name in ("ease_in", "ease_in_out"):
+            left[idx] = np.stack([t - EASE_LENGTH * before[idx], v], axis=1)
+            lt[idx] = "free"
+            interp[np.maximum(idx - 1, 0)[idx > 0]] = "bezier"
+        if name in ("ease_out", "ease_in_out"):
+            right[idx] = np.stack([t + EASE_LENGTH * after[idx], v], axis=1)
+            rt[idx] = "free"
+            interp[idx] = "bezier"
+        return self._replace(left=left, right=right, left_type=lt, right_type=rt,
+                             interpolation=interp)
+
+    def scaled(self, indices, time_pivot, time_factor, value_pivot, value_factor):
+        """Keys ``indices`` (and their handles) scaled about ``(time_pivot, value_pivot)``.
+
+        A negative or zero time factor would reorder or merge keys: it is refused
+        (``ValueError``); the scaled keys' times are then clamped between the unscaled
+        neighbours as :meth:`with_keys_moved` does.
+        """
+        if not time_factor > 0:
+            raise ValueError(f"curve: expected a time factor > 0, got {time_factor}")
+        idx = np.unique(np.asarray(indices, dtype=int).reshape(-1))
+        times, values = self.times.copy(), self.values.copy()
+        left, right = self.left.copy(), self.right.copy()
+        new_t = time_pivot + (times[idx] - time_pivot) * time_factor
+        lo, hi = _bounds(self.times, idx)
+        new_t = np.clip(new_t, lo + MIN_GAP, hi - MIN_GAP)
+        new_t = np.maximum.accumulate(np.maximum(new_t, np.r_[-np.inf, new_t[:-1] + MIN_GAP]))
+        for pts in (left, right):
+            pts[idx, 0] = new_t + (pts[idx, 0] - times[idx]) * time_factor
+            pts[idx, 1] = value_pivot + (pts[idx, 1] - value_pivot) * value_factor
+        times[idx] = new_t
+        values[idx] = value_pivot + (values[idx] - value_pivot) * value_factor
+        return self._replace(times=times, values=values, left=left, right=right)
+
+    def key_near(self, t, v, t_tol, v_tol):
+        """Index of the key nearest ``(t, v)`` within ``t_tol`` seconds and ``v_tol`` units
+        (distance measured in tolerances), or None."""
+        d = np.hypot((self.times - t) / t_tol, (self.values - v) / v_tol)
+        i = int(np.argmin(d))
+        return i if d[i] <= 1.0 else None
+
+    def __eq__(self, other):
+        if not isinstance(other, Curve) or len(other) != len(self):
+            return NotImplemented if not isinstance(other, Curve) else False
+        return (all(np.array_equal(getattr(self, a), getattr(other, a))
+                    for a in ("times", "values", "left", "right"))
+                and all(list(getattr(self, a)) == list(getattr(other, a))
+                        for a in ("interpolation", "left_type", "right_type")))
+
+    __hash__ = None
+
+    def __repr__(self):
+        return (f"Curve({len(self)} keys, {self.times[0]:g}..{self.times[-1]:g}s, "
+                f"{', '.join(sorted(set(self.interpolation)))})")
+
+
+#: Closest two keys may come (seconds) when a key is moved towards its neighbour.
+MIN_GAP = 1e-4
+
+
+def _bounds(times, idx):
+    """(M,) times of the nearest unmoved key before and after each moved key (+-inf)."""
+    moved = np.zeros(len(times), dtype=bool)
+    moved[idx] = True
+    fixed = np.flatnonzero(~moved)
+    if len(fixed) == 0:
+        return np.full(len(idx), -np.inf), np.full(len(idx), np.inf)
+    pos = np.searchsorted(fixed, idx)
+    lo = np.where(pos > 0, times[fixed[np.maximum(pos - 1, 0)]], -np.inf)
+    hi = np.where(pos < len(fixed), times[fixed[np.minimum(pos, len(fixed) - 1)]], np.inf)
+    return lo, hi
+
+
+def _clamp_shift(times, idx, dt):
+    """``dt`` clamped so the keys ``idx`` shifted by it stay between their unmoved
+    neighbours (:data:`MIN_GAP` apart)."""
+    lo, hi = _bounds(times, idx)
+    t = times[idx]
+    return float(np.clip(dt, np.max(lo + MIN_GAP - t), np.min(hi - MIN_GAP - t)))
+
+
+def bezier_points(times, values, left, right):
+    """Control points of each segment of a curve, time extents corrected.
+
+    Parameters
+    ----------
+    times, values : (K,) float
+    left, right : (K, 2) float
+
+    Returns
+    -------
+    points : (K - 1, 4, 2) float
+        Per segment: key k, its out-handle, key k + 1's in-handle, key k + 1; the handles
+        scaled towards their keys where their time extents overlap (sum over the segment's
+        duration), so that x(u) is monotone.
+    """
+    p0 = np.stack([times[:-1], values[:-1]], axis=1)
+    p3 = np.stack([times[1:], values[1:]], axis=1)
+    h1 = right[:-1] - p0
+    h2 = left[1:] - p3
+    dt = p3[:, 0] - p0[:, 0]
+    reach = np.maximum(h1[:, 0], 0) - np.minimum(h2[:, 0], 0)
+    f = np.where(reach > dt, dt / np.maximum(reach, 1e-300), 1.0)[:, None]
+    return np.stack([p0, p0 + h1 * f, p3 + h2 * f, p3], axis=1)
+
+
+def solve_u(x, t, iterations=30):
+    """Parameters u in [0, 1] with ``x(u) = t`` for monotone cubic Beziers.
+
+    Parameters
+    ----------
+    x : (N, 4) float
+        The time control points of each segment.
+    t : (N,) float
+        Times inside each segment.
+
+    Returns
+    -------
+    u : (N,) float
+        Newton steps from the linear guess, kept inside a shrinking bisection bracket (a step
+        leaving it bisects), until every residual is under 1e-12 of the segment's duration.
+    """
+    x0, x1, x2, x3 = x[:, 0], x[:, 1], x[:, 2], x[:, 3]
+    # power basis: x(u) = a u^3 + b u^2 + c u + x0
+    c = 3 * (x1 - x0)
+    b = 3 * (x2 - 2 * x1 + x0)
+    a = x3 - x0 - c - b
+    span = np.maximum(x3 - x0, 1e-300)
+    u = np.clip((t - x0) / span, 0.0, 1.0)
+    lo, hi = np.zeros_like(u), np.ones_like(u)
+    tol = 1e-12 * span
+    for _ in range(iterations):
+        f = ((a * u + b) * u + c) * u + x0 - t
+        if np.all(np.abs(f) <= tol):
+            break
+        lo = np.where(f < 0, u, lo)
+        hi = np.where(f > 0, u, hi)
+        d = (3 * a * u + 2 * b) * u + c
+        with np.errstate(divide="ignore", invalid="ignore"):
+            step = u - f / d
+        bad = ~np.isfinite(step) | (step <= lo) | (step >= hi)
+        u = np.where(bad, 0.5 * (lo + hi), step)
+    return u
+
+
+def evaluate(seg, interpolation, t):
+    """Values of segments at times inside them.
+
+    Parameters
+    ----------
+    seg : (N, 4, 2) float
+        Control points (:func:`bezier_points`) of the segment each time falls in.
+    interpolation : (N,) str or (N,) int
+        Names from :data:`INTERPOLATIONS` or their indices.
+    t : (N,) float
+
+    Returns
+    -------
+    values : (N,) float
+    """
+    code = np.asarray(interpolation)
+    if code.dtype == object:
+        code = np.array([INTERPOLATIONS.index(n) for n in code], dtype=np.int8)
+    p0, p3 = seg[:, 0], seg[:, 3]
+    frac = (t - p0[:, 0]) / np.maximum(p3[:, 0] - p0[:, 0], 1e-300)
+    out = np.where(t >= p3[:, 0], p3[:, 1], p0[:, 1])        # constant (the last key at its end)
+    lin = code == 1
+    out[lin] = p0[lin, 1] + (p3[lin, 1] - p0[lin, 1]) * frac[lin]
+    bez = code == 2
+    if bez.any():
+        s = seg[bez]
+        u = solve_u(s[:, :, 0], t[bez])
+        w = 1 - u
+        y = s[:, :, 1]
+        out[bez] = (w ** 3 * y[:, 0] + 3 * w * w * u * y[:, 1] + 3 * w * u * u * y[:, 2]
+                    + u ** 3 * y[:, 3])
+    return out

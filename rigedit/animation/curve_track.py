@@ -1,0 +1,133 @@
+"""Tracks as curves: any track's three :class:`~rigedit.animation.curve.Curve`, and the key
+edits of a bezier track's curves (removing and retiming keys by time).
+
+Conversion (:func:`curves_from_track`), per mode of the track:
+
+=========================================  ===============================================
+``step``                                   ``constant`` keys
+``linear``, ``nlerp``, ``slerp``,          ``linear`` keys: exact for translation and
+``hybrid``                                 scale; for a rotation the Euler angles run
+                                           linearly between keys, which is not the arc
+                                           slerp takes (close for keys tens of degrees
+                                           apart, further off for wide ones)
+``catmull_rom``, ``cubic_spline``          ``bezier`` keys with ``free`` handles a third of
+                                           each segment long: exact for vectors (a cubic
+                                           Hermite is that Bezier); for a rotation the
+                                           handles follow the track's Euler velocity at the
+                                           key (a finite difference)
+=========================================  ===============================================
+
+Rotations become Euler angles per key in degrees (:func:`~.euler_curves.quat_to_euler`,
+unwrapped so the curves stay continuous across +-180 degrees).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .curve import Curve
+from .euler_curves import DEFAULT_ORDER, quat_to_euler
+
+__all__ = ["curves_from_track", "remove_times", "retime"]
+
+_KIND = {"step": "constant", "linear": "linear", "nlerp": "linear", "slerp": "linear",
+         "hybrid": "linear", "catmull_rom": "bezier", "cubic_spline": "bezier"}
+
+
+def _slopes(track, euler, euler_order):
+    """(K, 2, 3) in- and out-velocities (per second) of a spline track at its keys: its
+    tangents for vectors, a finite difference of its Euler angles for rotations."""
+    if track.channel != "rotation":
+        tan = track.tangents
+        return tan if tan.ndim == 3 else np.repeat(tan[:, None], 2, axis=1)
+    times = track.times
+    span = np.min(np.diff(times)) if len(times) > 1 else 1.0
+    eps = 1e-4 * span
+    out = np.empty((len(times), 2, 3))
+    for side, sign in ((0, -1.0), (1, 1.0)):
+        near = [track.sample(t + sign * eps) for t in times]
+        angles = np.array([quat_to_euler(q[None], euler_order, e)[0]
+                           for q, e in zip(near, euler)])
+        out[:, side] = sign * (angles - euler) / eps
+    # the end keys' outer sides are clamped (no motion beyond the keys): reuse the inner one
+    out[0, 0], out[-1, 1] = out[0, 1], out[-1, 0]
+    return out
+
+
+def curves_from_track(track, euler_order=DEFAULT_ORDER):
+    """The three curves (X, Y, Z) of a track; a bezier track's own.
+
+    Parameters
+    ----------
+    track : Track
+    euler_order : str
+        For a rotation track that is not bezier yet: the order of its Euler angles.
+
+    Returns
+    -------
+    curves : tuple of 3 Curve
+    """
+    if track.curves is not None:
+        return track.curves
+    times = track.times
+    rotation = track.channel == "rotation"
+    values = quat_to_euler(track.values, euler_order) if rotation else track.values
+    kind = _KIND[track.interpolation]
+    if kind != "bezier" or len(times) < 2:
+        return tuple(Curve(times, values[:, a], kind) for a in range(3))
+    slopes = _slopes(track, values, euler_order)
+    dt = np.diff(times)
+    before, after = np.r_[dt[0], dt] / 3, np.r_[dt, dt[-1]] / 3
+    curves = []
+    for a in range(3):
+        v = values[:, a]
+        left = np.stack([times - before, v - slopes[:, 0, a] * before], axis=1)
+        right = np.stack([times + after, v + slopes[:, 1, a] * after], axis=1)
+        curves.append(Curve(times, v, "bezier", left, right, "free", "free"))
+    return tuple(curves)
+
+
+def _key_mask(curve, times, tol):
+    return np.any(np.abs(curve.times[:, None] - np.asarray(times)[None, :]) <= tol, axis=1)
+
+
+def remove_times(curves, times, tol):
+    """The curves without their keys within ``tol`` of ``times``; a curve left without keys
+    holds its old value at the first remaining key time of the others. None when no curve
+    keeps a key."""
+    kept = [c.without_keys(np.flatnonzero(_key_mask(c, times, tol))) for c in curves]
+    if all(k is None for k in kept):
+        return None
+    first = min(k.times[0] for k in kept if k is not None)
+    return tuple(Curve([first], [c.sample(first)]) if k is None else k
+                 for c, k in zip(curves, kept))
+
+
+def retime(curve, mapping, tol):
+    """``curve`` with keys moved in time: ``mapping`` is ``{old time: new time}``; a moved key
+    keeps its handles' offsets and replaces an unmoved key at its new time. The curve itself
+    when no key is at an old time."""
+    src, dst = [], []
+    for old, new in mapping.items():
+        d = np.abs(curve.times - old)
+        i = int(np.argmin(d))
+        if d[i] <= tol:
+            src.append(i)
+            dst.append(float(new))
+    if not src:
+        return curve
+    src, dst = np.array(src), np.array(dst)
+    moved = np.zeros(len(curve), dtype=bool)
+    moved[src] = True
+    rest = np.flatnonzero(~moved & ~_key_mask(curve, dst, tol))
+    idx = np.r_[rest, src]
+    times = np.r_[curve.times[rest], dst]
+    shift = times - curve.times[idx]
+    order = np.argsort(times, kind="stable")
+    idx, times, shift = idx[order], times[order], shift[order]
+    keep = np.r_[True, np.diff(times) > tol]   # two moved onto one time: one of them stays
+    idx, times, shift = idx[keep], times[keep], shift[keep]
+    left, right = curve.left[idx].copy(), curve.right[idx].copy()
+    left[:, 0] += shift
+    right[:, 0] += shift
+    return Curve(times, curve.values[idx], curve.interpolation[idx], left, right,
+                 curve.left_type[idx], curve.right_type[idx])

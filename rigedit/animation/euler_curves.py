@@ -1,0 +1,111 @@
+"""Rotations as Euler angles in degrees, per key, kept continuous for curves.
+
+Convention: an Euler order such as ``"XYZ"`` names the axes in the order the rotations
+apply, about the parent's fixed axes: ``R = Rz(z) Ry(y) Rx(x)`` for ``XYZ`` (Blender's
+meaning of its Euler modes; scipy's *extrinsic* sequence ``"xyz"``). The angles are always
+stored X, Y, Z whatever the order, so a curve's axis index is its axis.
+
+Unwrapping: scipy returns each key's angles in principal ranges, which jump by 360 degrees
+across +-180 and may pick the other of the two Euler triples of one rotation. Each key takes
+the equivalent triple nearest the key before it (Blender's ``compatible_eul``): the two
+triples ``(a, b, c)`` and ``(a + 180, 180 - b, c + 180)`` (angles in the order's sequence,
+the same rotation for every Tait-Bryan order), each shifted by whole turns per angle.
+"""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+__all__ = ["EULER_ORDERS", "DEFAULT_ORDER", "quat_to_euler", "euler_to_quat", "unwrap"]
+
+EULER_ORDERS = ("XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX")
+DEFAULT_ORDER = "XYZ"
+
+
+def _check(order):
+    if order not in EULER_ORDERS:
+        raise ValueError(f"expected an Euler order in {EULER_ORDERS}, got {order!r}")
+    return [("XYZ".index(a)) for a in order]
+
+
+def euler_to_quat(angles, order=DEFAULT_ORDER):
+    """Quaternions (x, y, z, w) of Euler angles.
+
+    Parameters
+    ----------
+    angles : (N, 3) or (3,) float
+        Degrees about X, Y, Z.
+    order : str
+
+    Returns
+    -------
+    quats : (N, 4) or (4,) float
+    """
+    axes = _check(order)
+    a = np.asarray(angles, dtype=np.float64)
+    return Rotation.from_euler(order.lower(), a[..., axes], degrees=True).as_quat()
+
+
+def _nearest_turn(angles, reference):
+    return angles + 360.0 * np.round((reference - angles) / 360.0)
+
+
+def unwrap(angles, order=DEFAULT_ORDER, reference=None):
+    """Each row of Euler angles replaced by the equivalent triple nearest the row before.
+
+    Parameters
+    ----------
+    angles : (N, 3) float
+        Degrees X, Y, Z of N rotations in time order.
+    order : str
+    reference : (3,) float, optional
+        What the first row is brought near (left in principal range when None).
+
+    Returns
+    -------
+    angles : (N, 3) float
+        The same rotations, continuous where the rotations are.
+    """
+    axes = _check(order)
+    seq = np.asarray(angles, dtype=np.float64)[:, axes]
+    alt = seq + np.array([180.0, 0.0, 180.0])
+    alt[:, 1] = 180.0 - seq[:, 1]
+    out = np.empty_like(seq)
+    prev = None if reference is None else np.asarray(reference, dtype=float)[axes]
+    for i in range(len(seq)):   # sequential: each key depends on the one before
+        if prev is None:
+            out[i] = seq[i]
+        else:
+            a, b = _nearest_turn(seq[i], prev), _nearest_turn(alt[i], prev)
+            out[i] = a if np.sum((a - prev) ** 2) <= np.sum((b - prev) ** 2) else b
+        prev = out[i]
+    res = np.empty_like(out)
+    res[:, axes] = out
+    return res
+
+
+def quat_to_euler(quats, order=DEFAULT_ORDER, reference=None):
+    """Continuous Euler angles (degrees X, Y, Z) of quaternions in time order.
+
+    Parameters
+    ----------
+    quats : (N, 4) float
+        x, y, z, w.
+    order : str
+    reference : (3,) float, optional
+        Angles the first key is brought near (see :func:`unwrap`).
+
+    Returns
+    -------
+    angles : (N, 3) float
+    """
+    axes = _check(order)
+    with warnings.catch_warnings():   # gimbal lock: scipy picks one of the triples, as we do
+        warnings.simplefilter("ignore", UserWarning)
+        seq = Rotation.from_quat(np.asarray(quats, dtype=np.float64).reshape(-1, 4)) \
+            .as_euler(order.lower(), degrees=True)
+    angles = np.empty_like(seq)
+    angles[:, axes] = seq
+    return unwrap(angles, order, reference)
