@@ -52,6 +52,8 @@ class JointGizmos(LeftButtonDrag):
         Where the spheres live; the plotter's renderer by default.
     deform : (J,) bool, optional
         Joints that take skin weight (the others are drawn greyer).
+    carriers : (J,) bool, optional
+        Carrier roots, drawn dimmer still (:data:`~rigedit.render.joint_glyphs.CARRIER_COLOR`).
 
     Attributes
     ----------
@@ -70,7 +72,7 @@ class JointGizmos(LeftButtonDrag):
     PICK_PIXELS = 5.0  # a sphere smaller than this on screen is picked as if this big
 
     def __init__(self, plotter, positions, radius, on_start=None, on_move=None, on_end=None,
-                 renderer=None, deform=None):
+                 renderer=None, deform=None, carriers=None):
         self.plotter = plotter
         self.renderer = renderer or plotter.renderer
         self.on_start, self.on_move, self.on_end = on_start, on_move, on_end
@@ -78,7 +80,7 @@ class JointGizmos(LeftButtonDrag):
         self.errors = []
         self.on_error = None
         self._grab = None
-        self.glyphs = JointGlyphs(positions, self.radius, deform=deform)
+        self.glyphs = JointGlyphs(positions, self.radius, deform=deform, carriers=carriers)
         self.renderer.AddActor(self.glyphs.actor)
         iren = getattr(plotter.iren, "interactor", None) if plotter.iren is not None else None
         self._iren = iren

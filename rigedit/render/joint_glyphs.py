@@ -17,10 +17,13 @@ from vtkmodules.vtkRenderingCore import vtkActor
 from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLSphereMapper
 
 __all__ = ["JointGlyphs", "SPHERE_COLOR", "SELECTED_COLOR", "ACTIVE_COLOR",
-           "NON_DEFORMING_COLOR", "hover_color"]
+           "NON_DEFORMING_COLOR", "CARRIER_COLOR", "hover_color"]
 
 SPHERE_COLOR = (0.55, 0.78, 1.0)
-NON_DEFORMING_COLOR = (0.60, 0.65, 0.74)  # takes no skin weight (a ground-level root)
+NON_DEFORMING_COLOR = (0.60, 0.65, 0.74)  # takes no skin weight
+#: A carrier root (a joint on the floor or at the origin that only moves the figure): dim,
+#: between the bones' grey and the background, so it does not read as a joint of the body
+CARRIER_COLOR = (0.68, 0.70, 0.74)
 SELECTED_COLOR = (1.0, 0.62, 0.10)
 ACTIVE_COLOR = (1.0, 0.95, 0.35)  # while being dragged
 
@@ -45,6 +48,8 @@ class JointGlyphs:
         Sphere radius (model units).
     deform : (J,) bool, optional
         Joints that take skin weight; the others are drawn in ``NON_DEFORMING_COLOR``.
+    carriers : (J,) bool, optional
+        Carrier roots, drawn in ``CARRIER_COLOR`` (see :mod:`rigedit.model.carrier`).
 
     Attributes
     ----------
@@ -56,7 +61,7 @@ class JointGlyphs:
         Joints drawn highlighted (in that order of precedence, ``active`` first).
     """
 
-    def __init__(self, positions, radius, deform=None):
+    def __init__(self, positions, radius, deform=None, carriers=None):
         positions = np.asarray(positions, dtype=float).reshape(-1, 3)
         self.radius = float(radius)
         self.points = pv.PolyData(positions.copy())
@@ -64,6 +69,8 @@ class JointGlyphs:
         n = len(positions)
         self.deform = np.ones(n, dtype=bool) if deform is None else \
             np.asarray(deform, dtype=bool).reshape(n)
+        self.carriers = np.zeros(n, dtype=bool) if carriers is None else \
+            np.asarray(carriers, dtype=bool).reshape(n)
         self.selected = self.hovered = self.active = None
         self._colors = np.zeros((n, 3), dtype=np.uint8)
         self.points.point_data["rgb"] = self._colors
@@ -136,6 +143,7 @@ class JointGlyphs:
 
     def _recolor(self):
         colors = np.where(self.deform[:, None], _rgb(SPHERE_COLOR), _rgb(NON_DEFORMING_COLOR))
+        colors[self.carriers] = _rgb(CARRIER_COLOR)
         if self.selected is not None:
             colors[self.selected] = _rgb(SELECTED_COLOR)
         if self.hovered is not None:

@@ -89,16 +89,18 @@ class RigScene:
             self._texture = look.get("texture")
             self._connect_normals()
         sk = rig.skeleton
-        self.bones, self.bone_actor = add_bones(plotter, sk, bold=not self.has_mesh)
-        self.bone_actor.SetVisibility(show_skeleton or not self.has_mesh)
+        #: (J,) bool: carrier roots (joints that only carry the figure), drawn thin and dim
+        self.carriers, _ = figure_joints(rig)
+        self.bones, self.bone_actor, self.carrier_actor = add_bones(
+            plotter, sk, bold=not self.has_mesh, carriers=self.carriers)
+        self.set_skeleton_visible(show_skeleton or not self.has_mesh)
         #: The joint balls and tails of a rig with no mesh, or None
         self.bare_skeleton = None if self.has_mesh else BareSkeleton(plotter, rig)
         #: The :class:`~rigedit.render.floor.Floor`, or None; it follows the figure's root
         #: (the hips below any carrier root) in whole cells as the pose moves
         self.floor = self._add_floor(floor_style) if show_floor else None
         self.floor_actor = None if self.floor is None else self.floor.grid_actor
-        self._floor_joint = figure_root(sk.parents, figure_joints(rig)[0]) if show_floor \
-            else 0
+        self._floor_joint = figure_root(sk.parents, self.carriers)
         self.display_mode = "solid"
         self.weights_shown = False
         self._weight_lut = None
@@ -187,7 +189,20 @@ class RigScene:
                      1 if self.rig.up == "y" else 2, self.up, style=style)
 
     def set_skeleton_visible(self, visible):
-        self.bone_actor.SetVisibility(bool(visible))
+        for actor in (self.bone_actor, self.carrier_actor):
+            if actor is not None:
+                actor.SetVisibility(bool(visible))
+
+    def put_bones_on(self, renderer, width):
+        """Draw the bone lines on ``renderer`` (the editor's overlay, over the mesh), the
+        bones ``width`` pixels wide and a carrier's a third of that."""
+        self.bone_actor.GetProperty().SetLineWidth(width)
+        self.plotter.renderer.RemoveActor(self.bone_actor)
+        renderer.AddActor(self.bone_actor)
+        if self.carrier_actor is not None:
+            self.carrier_actor.GetProperty().SetLineWidth(max(1.0, width / 3.0))
+            self.plotter.renderer.RemoveActor(self.carrier_actor)
+            renderer.AddActor(self.carrier_actor)
 
     def set_floor_visible(self, visible):
         for name in ("rig-floor", "rig-grid"):

@@ -10,13 +10,19 @@ from __future__ import annotations
 import numpy as np
 import pyvista as pv
 
-__all__ = ["BONE_COLOR", "add_bones", "BareSkeleton"]
+__all__ = ["BONE_COLOR", "CARRIER_COLOR", "add_bones", "BareSkeleton"]
 
 BONE_COLOR = "#2f6fd6"
+#: A carrier root's "bone" (from the floor or the origin up to the hips): thin and dim, a
+#: line that shows what carries the figure without reading as a limb
+CARRIER_COLOR = "#98a4b4"
+#: Line widths in pixels: (bone, carrier's) with a mesh, and bold (a skeleton alone)
+WIDTHS = {False: (3, 1), True: (5, 2)}
 
 
-def add_bones(plotter, skeleton, bold=False):
-    """Add one line per bone at the bind pose.
+def add_bones(plotter, skeleton, bold=False, carriers=None):
+    """Add one line per bone at the bind pose; a carrier's lines to its children in an
+    actor of their own, thin and in :data:`CARRIER_COLOR`.
 
     Parameters
     ----------
@@ -24,26 +30,49 @@ def add_bones(plotter, skeleton, bold=False):
     skeleton : Skeleton
     bold : bool
         Wider lines, for a skeleton shown without a mesh.
+    carriers : (J,) bool, optional
+        Carrier roots (:func:`rigedit.render.camera.figure_joints`); a non-deforming root
+        counts as one either way.
 
     Returns
     -------
     bones : pyvista.PolyData
-        One point per joint (its position), one line per bone.
+        One point per joint (its position), one line per bone but the carriers'.
     actor : vtk.vtkActor
+    carrier_actor : vtk.vtkActor or None
+        The carriers' lines (``rig-carrier-bones``), sharing ``bones``' points; None for a
+        rig without a carrier.
     """
-    # No line from a non-deforming root (a ground-level carrier) to its children: that
-    # "bone" moves no skin and would cut through the body down to the floor.
     sk = skeleton
     carrier = (sk.parents < 0) & ~sk.deform
-    child = np.flatnonzero((sk.parents >= 0) & ~carrier[np.maximum(sk.parents, 0)])
-    lines = np.column_stack([np.full(len(child), 2), sk.parents[child], child]).ravel()
+    if carriers is not None:
+        carrier = carrier | np.asarray(carriers, dtype=bool)
+    has_parent = sk.parents >= 0
+    from_carrier = has_parent & carrier[np.maximum(sk.parents, 0)]
     bones = pv.PolyData(sk.bind_matrices[:, :3, 3].copy())
+    width, thin = WIDTHS[bool(bold)]
+    child = np.flatnonzero(has_parent & ~from_carrier)
     if len(child):
-        bones.lines = lines
-    actor = plotter.add_mesh(bones, color=BONE_COLOR, line_width=5 if bold else 3,
+        bones.lines = _lines(sk.parents, child)
+    actor = plotter.add_mesh(bones, color=BONE_COLOR, line_width=width,
                              render_lines_as_tubes=False, name="rig-bones",
                              reset_camera=False)
-    return bones, actor
+    carried = np.flatnonzero(from_carrier)
+    carrier_actor = None
+    if len(carried):
+        lines = pv.PolyData()
+        lines.SetPoints(bones.GetPoints())   # moved with the bones, no copy per frame
+        lines.lines = _lines(sk.parents, carried)
+        carrier_actor = plotter.add_mesh(lines, color=CARRIER_COLOR, line_width=thin,
+                                         render_lines_as_tubes=False,
+                                         name="rig-carrier-bones", reset_camera=False,
+                                         pickable=False)
+    return bones, actor, carrier_actor
+
+
+def _lines(parents, child):
+    """VTK line cells from each joint of ``child`` to its parent."""
+    return np.column_stack([np.full(len(child), 2), parents[child], child]).ravel()
 
 
 class BareSkeleton:

@@ -85,12 +85,10 @@ class SceneView:
         self.plotter.enable_lightkit()  # clear() removed the lights too
         rig = self.document.rig
         self.scene = RigScene(self.plotter, rig, show_skeleton=self.skeleton_visible)
-        self.scene.bone_actor.GetProperty().SetLineWidth(4)
         # Bones, joint spheres and axis handles are drawn over the mesh, as "in front".
         self.overlay = overlay_renderer(self.plotter)
         self.overlay.RemoveAllViewProps()
-        self.plotter.renderer.RemoveActor(self.scene.bone_actor)
-        self.overlay.AddActor(self.scene.bone_actor)
+        self.scene.put_bones_on(self.overlay, width=4)
         self.scene.view("front", angle=35)
         self.scene.set_display_mode(self.display_mode)
         if not self.scene.has_mesh and self.weights_view:  # a BVH skeleton: no skin to paint
@@ -98,7 +96,8 @@ class SceneView:
         self.scene.set_floor_visible(self.floor_visible)
         self.radius = gizmo_radius(rig)
         self.gizmos = JointGizmos(self.plotter, self.scene.joint_positions, self.radius,
-                                  renderer=self.overlay, deform=rig.skeleton.deform)
+                                  renderer=self.overlay, deform=rig.skeleton.deform,
+                                  carriers=self.scene.carriers)
         self.gizmos.on_error = self.report_exception
         self.gizmos.set_visible(self.gizmos_visible)
         self.axes = AxisHandles(self.plotter, 10 * self.radius, renderer=self.overlay,
