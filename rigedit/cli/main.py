@@ -128,6 +128,7 @@ def build_parser():
 
     render.add_parser(sub)
     from . import batch; batch.add_parser(sub)  # noqa: E702  rigedit batch (issue 21)
+    from . import compress; compress.add_parser(sub)  # noqa: E702  rigedit compress (issue 20)
     export.add_parser(sub)
     _add_retarget(sub)
     _add_autorig(sub)
