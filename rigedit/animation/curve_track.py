@@ -5,16 +5,21 @@ Conversion (:func:`curves_from_track`), per mode of the track:
 
 =========================================  ===============================================
 ``step``                                   ``constant`` keys
-``linear``, ``nlerp``, ``slerp``,          ``linear`` keys: exact for translation and
-``hybrid``                                 scale; for a rotation the Euler angles run
-                                           linearly between keys, which is not the arc
-                                           slerp takes (close for keys tens of degrees
-                                           apart, further off for wide ones)
+``linear``                                 ``linear`` keys (exact)
+``nlerp``, ``slerp``, ``hybrid``           ``bezier`` keys whose ``free`` handles follow the
+(rotations)                                track's Euler velocity on each side of the key
+                                           (a finite difference): Euler angles running
+                                           linearly between keys would leave the arc slerp
+                                           takes (9 degrees off mid-segment on keys 25 to
+                                           123 degrees apart; these handles: under 1 for
+                                           slerp, under 2 for nlerp)
 ``catmull_rom``, ``cubic_spline``          ``bezier`` keys with ``free`` handles a third of
                                            each segment long: exact for vectors (a cubic
                                            Hermite is that Bezier); for a rotation the
-                                           handles follow the track's Euler velocity at the
-                                           key (a finite difference)
+                                           handles follow the Euler velocity as above (a
+                                           cubic in Euler angles is not one in quaternions:
+                                           same keys and velocities, up to 8 degrees apart
+                                           mid-segment on the same keys)
 =========================================  ===============================================
 
 Rotations become Euler angles per key in degrees (:func:`~.euler_curves.quat_to_euler`,
@@ -25,12 +30,12 @@ from __future__ import annotations
 import numpy as np
 
 from .curve import Curve
-from .euler_curves import DEFAULT_ORDER, quat_to_euler
+from .euler_curves import DEFAULT_ORDER, nearest, principal, quat_to_euler
 
 __all__ = ["curves_from_track", "remove_times", "retime"]
 
-_KIND = {"step": "constant", "linear": "linear", "nlerp": "linear", "slerp": "linear",
-         "hybrid": "linear", "catmull_rom": "bezier", "cubic_spline": "bezier"}
+_KIND = {"step": "constant", "linear": "linear", "nlerp": "bezier", "slerp": "bezier",
+         "hybrid": "bezier", "catmull_rom": "bezier", "cubic_spline": "bezier"}
 
 
 def _slopes(track, euler, euler_order):
@@ -44,9 +49,8 @@ def _slopes(track, euler, euler_order):
     eps = 1e-4 * span
     out = np.empty((len(times), 2, 3))
     for side, sign in ((0, -1.0), (1, 1.0)):
-        near = [track.sample(t + sign * eps) for t in times]
-        angles = np.array([quat_to_euler(q[None], euler_order, e)[0]
-                           for q, e in zip(near, euler)])
+        near = np.array([track.sample(t + sign * eps) for t in times])
+        angles = nearest(principal(near, euler_order), euler_order, euler)
         out[:, side] = sign * (angles - euler) / eps
     # the end keys' outer sides are clamped (no motion beyond the keys): reuse the inner one
     out[0, 0], out[-1, 1] = out[0, 1], out[-1, 0]

@@ -18,7 +18,8 @@ import warnings
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-__all__ = ["EULER_ORDERS", "DEFAULT_ORDER", "quat_to_euler", "euler_to_quat", "unwrap"]
+__all__ = ["EULER_ORDERS", "DEFAULT_ORDER", "quat_to_euler", "euler_to_quat", "unwrap", "principal",
+           "nearest"]
 
 EULER_ORDERS = ("XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX")
 DEFAULT_ORDER = "XYZ"
@@ -52,6 +53,41 @@ def _nearest_turn(angles, reference):
     return angles + 360.0 * np.round((reference - angles) / 360.0)
 
 
+def _triples(angles, axes):
+    """The two equivalent triples of each row, in the order's sequence: (2, N, 3)."""
+    seq = np.asarray(angles, dtype=np.float64)[:, axes]
+    alt = seq + np.array([180.0, 0.0, 180.0])
+    alt[:, 1] = 180.0 - seq[:, 1]
+    return seq, alt
+
+
+def _pick(a, b, ref):
+    """Per row, the triple of ``a`` or ``b`` (whole turns added) nearest ``ref``."""
+    a, b = _nearest_turn(a, ref), _nearest_turn(b, ref)
+    closer = np.sum((a - ref) ** 2, axis=-1) <= np.sum((b - ref) ** 2, axis=-1)
+    return np.where(closer[..., None], a, b)
+
+
+def nearest(angles, order, references):
+    """Each row of Euler angles as the equivalent triple nearest its own reference row.
+
+    Parameters
+    ----------
+    angles, references : (N, 3) float
+        Degrees X, Y, Z.
+    order : str
+
+    Returns
+    -------
+    angles : (N, 3) float
+    """
+    axes = _check(order)
+    seq, alt = _triples(angles, axes)
+    out = np.empty_like(seq)
+    out[:, axes] = _pick(seq, alt, np.asarray(references, dtype=float)[:, axes])
+    return out
+
+
 def unwrap(angles, order=DEFAULT_ORDER, reference=None):
     """Each row of Euler angles replaced by the equivalent triple nearest the row before.
 
@@ -69,21 +105,28 @@ def unwrap(angles, order=DEFAULT_ORDER, reference=None):
         The same rotations, continuous where the rotations are.
     """
     axes = _check(order)
-    seq = np.asarray(angles, dtype=np.float64)[:, axes]
-    alt = seq + np.array([180.0, 0.0, 180.0])
-    alt[:, 1] = 180.0 - seq[:, 1]
+    seq, alt = _triples(angles, axes)
     out = np.empty_like(seq)
     prev = None if reference is None else np.asarray(reference, dtype=float)[axes]
     for i in range(len(seq)):   # sequential: each key depends on the one before
-        if prev is None:
-            out[i] = seq[i]
-        else:
-            a, b = _nearest_turn(seq[i], prev), _nearest_turn(alt[i], prev)
-            out[i] = a if np.sum((a - prev) ** 2) <= np.sum((b - prev) ** 2) else b
+        out[i] = seq[i] if prev is None else _pick(seq[i], alt[i], prev)
         prev = out[i]
     res = np.empty_like(out)
     res[:, axes] = out
     return res
+
+
+def principal(quats, order=DEFAULT_ORDER):
+    """(N, 3) Euler angles (degrees X, Y, Z) of quaternions, each in scipy's principal
+    range (not unwrapped)."""
+    axes = _check(order)
+    with warnings.catch_warnings():   # gimbal lock: scipy picks one of the triples, as we do
+        warnings.simplefilter("ignore", UserWarning)
+        seq = Rotation.from_quat(np.asarray(quats, dtype=np.float64).reshape(-1, 4)) \
+            .as_euler(order.lower(), degrees=True)
+    angles = np.empty_like(seq)
+    angles[:, axes] = seq
+    return angles
 
 
 def quat_to_euler(quats, order=DEFAULT_ORDER, reference=None):
@@ -101,11 +144,4 @@ def quat_to_euler(quats, order=DEFAULT_ORDER, reference=None):
     -------
     angles : (N, 3) float
     """
-    axes = _check(order)
-    with warnings.catch_warnings():   # gimbal lock: scipy picks one of the triples, as we do
-        warnings.simplefilter("ignore", UserWarning)
-        seq = Rotation.from_quat(np.asarray(quats, dtype=np.float64).reshape(-1, 4)) \
-            .as_euler(order.lower(), degrees=True)
-    angles = np.empty_like(seq)
-    angles[:, axes] = seq
-    return unwrap(angles, order, reference)
+    return unwrap(principal(quats, order), order, reference)
