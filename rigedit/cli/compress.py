@@ -15,7 +15,7 @@ from pathlib import Path
 from .common import UsageError, load, scale_option
 
 __all__ = ["add_parser", "cmd_compress", "compression_options", "check_compression",
-           "compress_and_write", "DEFAULT_MAX_ERROR_CM", "DEFAULT_SHELL_CM"]
+           "compress_and_write", "clip_names", "DEFAULT_MAX_ERROR_CM", "DEFAULT_SHELL_CM"]
 
 #: The issue's glTF target: 0.01 cm on a 3 cm shell (ACL's metric).
 DEFAULT_MAX_ERROR_CM = 0.01
@@ -67,7 +67,7 @@ def check_compression(args, output):
                              "'rigedit[meshopt]')")
 
 
-def _clip_names(rig, wanted):
+def clip_names(rig, wanted):
     names = list(rig.clips) if not wanted else list(dict.fromkeys(wanted))
     unknown = [n for n in names if n not in rig.clips]
     if unknown:
@@ -133,7 +133,7 @@ def add_parser(sub):
 def cmd_compress(args):
     check_compression(args, args.output)
     rig = load(args.rig, scale=args.scale)
-    names = _clip_names(rig, args.clip)
+    names = clip_names(rig, args.clip)
     for line in compress_and_write(rig, names, args.output, args):
         print(line)
     print(f"wrote {Path(args.output).resolve()}: clips: {' '.join(names)}")

@@ -3,7 +3,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .common import load, scale_option
+from .common import UsageError, load, scale_option
+from .compress import clip_names, compress_and_write, compression_options, check_compression
 
 __all__ = ["add_parser", "cmd_export"]
 
@@ -20,6 +21,7 @@ def add_parser(sub):
     s.add_argument("--fbx-units", choices=("cm", "m"), default="cm",
                    help="length unit of an .fbx OUT: cm (the default, what Unity and Unreal "
                         "import at scale 1) or m")
+    compression_options(s, "--compress")
     scale_option(s)
     s.set_defaults(func=cmd_export, folder_output=True)
 
@@ -27,7 +29,21 @@ def add_parser(sub):
 def cmd_export(args):
     import rigedit
 
+    if args.compress:
+        if Path(args.output).suffix.lower() in (".fbx", ".bvh"):
+            raise UsageError(f"--compress: expected a .glb/.gltf OUT or a rig folder, got "
+                             f"{args.output}")
+        check_compression(args, args.output)
+    elif args.max_error is not None or args.shell is not None or args.meshopt:
+        raise UsageError("--max-error, --shell and --meshopt go with --compress")
     rig = load(args.rig, scale=args.scale)
+    if args.compress:
+        names = clip_names(rig, args.clip)
+        for line in compress_and_write(rig, names, args.output, args):
+            print(line)
+        print(f"wrote {Path(args.output).resolve()}: {len(rig.skeleton)} joints, "
+              f"{len(rig.vertices)} vertices, compressed clips: {' '.join(names)}")
+        return 0
     if Path(args.output).suffix.lower() == ".fbx":
         from ..io.fbx_write import write_fbx
 
