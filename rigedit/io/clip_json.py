@@ -9,6 +9,8 @@ rigedit format::
 Values are local (parent-space) joint transforms, as in a Pose: translations, unit
 quaternions (x, y, z, w), scales. A ``cubic_spline`` track (glTF's CUBICSPLINE) also has
 ``"tangents"``: per key, its in-tangent then its out-tangent (2 C numbers, units per second).
+A ``bezier`` track has three ``"curves"`` instead of times and values
+(:mod:`.clip_json_bezier`).
 
 Morph target weights (optional, absent in older files)::
 
@@ -37,6 +39,7 @@ from ..animation.clip import CHANNELS, Clip, Track
 from ..animation.morph_track import WEIGHT_MODES, WeightTrack
 from ..errors import RigFileError
 from .atomic import write_json
+from .clip_json_bezier import bezier_entry, read_bezier_track
 from .jsonfile import (MAX_SECONDS, boolean, choice, name, number, numbers, optional,
                        read_json, require, vector)
 
@@ -112,6 +115,9 @@ def _load_rigedit(path, data, skeleton):
             unknown.append(joint)
             continue
         where = f"track {i} ({joint!r} {channel})"
+        if optional(e, "interpolation", None) == "bezier":
+            tracks[(joint, channel)] = read_bezier_track(path, e, channel, where)
+            continue
         times = numbers(path, require(path, e, "times", list, f" in track {i}"),
                         "'times'", bound=MAX_SECONDS, where=where)
         if len(times) and times.min() < 0:   # a clip starts at 0 (as morph tracks do)
@@ -198,8 +204,9 @@ def load_clip(path, skeleton):
 
 def clip_to_dict(clip):
     """rigedit-format dictionary of a clip."""
-    tracks = [{"joint": joint, "channel": channel, "interpolation": tr.interpolation,
-               "times": tr.times.round(9).tolist(), "values": tr.values.round(9).tolist()}
+    tracks = [{"joint": joint, "channel": channel, **bezier_entry(tr)} if tr.curves is not None
+              else {"joint": joint, "channel": channel, "interpolation": tr.interpolation,
+                    "times": tr.times.round(9).tolist(), "values": tr.values.round(9).tolist()}
               for (joint, channel), tr in clip.tracks.items()]
     for entry, tr in zip(tracks, clip.tracks.values()):
         if tr.interpolation == "cubic_spline":  # glTF's CUBICSPLINE keeps its own tangents
