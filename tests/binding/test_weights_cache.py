@@ -149,3 +149,44 @@ def test_default_folder(monkeypatch, tmp_path):
     monkeypatch.delenv("XDG_CACHE_HOME")
     assert weights_cache.cache_folder() == \
         __import__("pathlib").Path.home() / ".cache" / "rigedit" / "weights"
+
+
+_WORKER = """
+import sys
+import numpy as np
+from rigedit.binding import weights_cache as wc
+seed = int(sys.argv[1])
+idx = np.zeros((2000, 4), np.int32)
+bad = hits = 0
+for i in range(60):
+    k = (seed * 7 + i) % 5            # five keys shared by the workers
+    w = np.zeros((2000, 4))
+    w[:, k % 4] = 1.0                 # each key's own weights
+    key = f"{k:064x}"
+    wc.store_weights(key, idx, w)
+    for other in (k, (k + 1) % 5):
+        got = wc.load_weights(f"{other:064x}", 2000, 1)
+        hits += got is not None
+        if got is not None and not np.all(got[1][:, other % 4] == 1.0):
+            bad += 1
+print(bad, hits)
+"""
+
+
+def test_concurrent_processes_never_see_a_part_of_an_entry(cache):
+    """Three processes store and read five keys with a bound of about three entries, so they
+    evict each other's files all the while: no error, and every hit is a whole entry."""
+    import subprocess
+    import sys
+
+    env = dict(os.environ, RIGEDIT_CACHE_MAX_MB=str(3.5 * 2000 * 4 * 12 / 2 ** 20))
+    procs = [subprocess.Popen([sys.executable, "-c", _WORKER, str(s)], env=env,
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+             for s in range(3)]
+    outs = [p.communicate(timeout=120) for p in procs]
+    assert [p.returncode for p in procs] == [0, 0, 0], [e for _, e in outs]
+    counts = [[int(n) for n in o.split()] for o, _ in outs]
+    assert [bad for bad, _ in counts] == [0, 0, 0]
+    assert sum(hits for _, hits in counts) > 60, counts   # read, not only evicted (of 360)
+    left = list(cache.glob("*.npz"))
+    assert 1 <= len(left) <= 4 and not list(cache.glob(".*.tmp"))
