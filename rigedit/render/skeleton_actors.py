@@ -37,7 +37,8 @@ def add_bones(plotter, skeleton, bold=False, carriers=None):
     Returns
     -------
     bones : pyvista.PolyData
-        One point per joint (its position), one line per bone but the carriers'.
+        One point per joint (its position), one line per bone but the carriers', one dot
+        (vertex cell) per joint but the carriers.
     actor : vtk.vtkActor
     carrier_actor : vtk.vtkActor or None
         The carriers' lines (``rig-carrier-bones``), sharing ``bones``' points; None for a
@@ -54,6 +55,9 @@ def add_bones(plotter, skeleton, bold=False, carriers=None):
     child = np.flatnonzero(has_parent & ~from_carrier)
     if len(child):
         bones.lines = _lines(sk.parents, child)
+    if carrier.any():   # each joint is also a dot (pyvista's vertex cells): not a carrier
+        kept = np.flatnonzero(~carrier)
+        bones.verts = np.column_stack([np.ones(len(kept), int), kept]).ravel()
     actor = plotter.add_mesh(bones, color=BONE_COLOR, line_width=width,
                              render_lines_as_tubes=False, name="rig-bones",
                              reset_camera=False)

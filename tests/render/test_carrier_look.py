@@ -46,6 +46,9 @@ def test_the_carrier_line_is_thin_and_dim(plotter, quadruped, bold):
     np.testing.assert_allclose(_color(carrier), pv.Color(sa.CARRIER_COLOR).float_rgb)
     np.testing.assert_allclose(_color(actor), pv.Color(sa.BONE_COLOR).float_rgb)
     assert carrier.GetProperty().GetLineWidth() < actor.GetProperty().GetLineWidth()
+    # no bright dot at the carrier (the bones draw a dot per joint)
+    dots = pv.wrap(actor.GetMapper().GetInput()).verts.reshape(-1, 2)[:, 1]
+    assert root not in dots and set(dots) == set(range(len(sk))) - {root}
     # dim: nearer the grey of the background than the bones' blue is
     bg = np.array(pv.Color("#dadfe5").float_rgb)
     assert np.linalg.norm(_color(carrier) - bg) < 0.5 * np.linalg.norm(_color(actor) - bg)
@@ -69,6 +72,7 @@ def test_a_rig_without_a_carrier_is_unchanged(plotter):
     assert not scene.carriers.any() and scene.carrier_actor is None
     assert "rig-carrier-bones" not in plotter.actors
     assert _lines(scene.bone_actor) == {(0, 1), (1, 2)}
+    assert pv.wrap(scene.bone_actor.GetMapper().GetInput()).n_verts == 3
     assert scene.bone_actor.GetProperty().GetLineWidth() == 3
 
 
