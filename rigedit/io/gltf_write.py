@@ -33,6 +33,7 @@ import scipy.sparse as sp
 from ..errors import RigFileError
 from .atomic import atomic_write
 from .data import as_rig_data
+from .gltf_bezier import bezier_keys
 from .gltf_write_morph import mesh_morph_fields, primitive_targets, weights_sampler
 
 __all__ = ["save_gltf", "RESAMPLE_DEGREES"]
@@ -253,7 +254,9 @@ def _float32_times(times):
 def _track_sampler(w, tr):
     """(sampler dict) of one track, mapping its interpolation to glTF's."""
     mode, times = tr.interpolation, tr.times
-    if mode in ("nlerp", "hybrid") and len(times) > 1:
+    if mode == "bezier":   # CUBICSPLINE where exact, else resampled (io/gltf_bezier.py)
+        times, values, kind = bezier_keys(tr)
+    elif mode in ("nlerp", "hybrid") and len(times) > 1:
         times = _key_times(tr)
         values = np.array([tr.sample(t) for t in times])
         kind = "LINEAR"
