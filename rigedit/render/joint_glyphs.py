@@ -21,9 +21,9 @@ __all__ = ["JointGlyphs", "SPHERE_COLOR", "SELECTED_COLOR", "ACTIVE_COLOR",
 
 SPHERE_COLOR = (0.55, 0.78, 1.0)
 NON_DEFORMING_COLOR = (0.60, 0.65, 0.74)  # takes no skin weight
-#: A carrier root (a joint on the floor or at the origin that only moves the figure): dim,
-#: between the bones' grey and the background, so it does not read as a joint of the body
-CARRIER_COLOR = (0.68, 0.70, 0.74)
+#: A carrier root (a joint on the floor or at the origin that only moves the figure): a dim
+#: mid grey, darker than the other spheres, so it does not read as a joint of the body
+CARRIER_COLOR = (0.50, 0.53, 0.58)
 SELECTED_COLOR = (1.0, 0.62, 0.10)
 ACTIVE_COLOR = (1.0, 0.95, 0.35)  # while being dragged
 

@@ -14,8 +14,9 @@ __all__ = ["BONE_COLOR", "CARRIER_COLOR", "add_bones", "BareSkeleton"]
 
 BONE_COLOR = "#2f6fd6"
 #: A carrier root's "bone" (from the floor or the origin up to the hips): thin and dim, a
-#: line that shows what carries the figure without reading as a limb
-CARRIER_COLOR = "#98a4b4"
+#: line that shows what carries the figure without reading as a limb. A mid grey, so it is
+#: quiet over the editor's dark background and the recorder's light one alike
+CARRIER_COLOR = "#7f8896"
 #: Line widths in pixels: (bone, carrier's) with a mesh, and bold (a skeleton alone)
 WIDTHS = {False: (3, 1), True: (5, 2)}
 

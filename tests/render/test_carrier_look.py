@@ -49,9 +49,11 @@ def test_the_carrier_line_is_thin_and_dim(plotter, quadruped, bold):
     # no bright dot at the carrier (the bones draw a dot per joint)
     dots = pv.wrap(actor.GetMapper().GetInput()).verts.reshape(-1, 2)[:, 1]
     assert root not in dots and set(dots) == set(range(len(sk))) - {root}
-    # dim: nearer the grey of the background than the bones' blue is
-    bg = np.array(pv.Color("#dadfe5").float_rgb)
-    assert np.linalg.norm(_color(carrier) - bg) < 0.5 * np.linalg.norm(_color(actor) - bg)
+    # dim: a grey (the bones are a saturated blue) of middle lightness, between the editor's
+    # dark background and the recorder's light one
+    assert np.ptp(_color(carrier)) < 0.1 < 0.5 < np.ptp(_color(actor))
+    dark, light = (np.mean(pv.Color(c).float_rgb) for c in ("#2b2f36", "#dadfe5"))
+    assert dark + 0.25 < np.mean(_color(carrier)) < light - 0.25
 
 
 def test_the_carrier_line_moves_with_the_bones_and_hides_with_them(plotter, quadruped):
@@ -82,6 +84,10 @@ def test_the_carrier_sphere_has_the_carrier_colour():
     np.testing.assert_allclose(glyphs.color_of(0), jg.CARRIER_COLOR, atol=1 / 255)
     np.testing.assert_allclose(glyphs.color_of(1), jg.SPHERE_COLOR, atol=1 / 255)
     np.testing.assert_allclose(glyphs.color_of(2), jg.NON_DEFORMING_COLOR, atol=1 / 255)
+    # dimmer (darker, greyer) than a joint's sphere, and than a non-deforming one's
+    for other in (jg.SPHERE_COLOR, jg.NON_DEFORMING_COLOR):
+        assert np.mean(jg.CARRIER_COLOR) < np.mean(other)
+        assert np.ptp(jg.CARRIER_COLOR) < np.ptp(other)
     glyphs.set_state(selected=0)    # selected, it shows as selected all the same
     np.testing.assert_allclose(glyphs.color_of(0), jg.SELECTED_COLOR, atol=1 / 255)
     plain = jg.JointGlyphs(pts, 0.1)
