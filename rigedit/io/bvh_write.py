@@ -43,7 +43,8 @@ _AXES = "XYZ"
 
 def bvh_frame_times(clip, fps=None):
     """Sample times for writing ``clip``: its key rate when every key lies on one regular grid
-    of step ``dt`` from time 0, else ``fps`` (default 30) frames per second.
+    of step ``dt`` from time 0 (divided down to 30 fps or finer when the clip has bezier
+    tracks, whose curves bend between keys), else ``fps`` (default 30) frames per second.
 
     Returns
     -------
@@ -61,6 +62,9 @@ def bvh_frame_times(clip, fps=None):
             grid = keys / step
             if step > 1e-6 and np.allclose(grid, np.round(grid), atol=1e-4):
                 dt = step
+                if any(tr.curves is not None for tr in clip.tracks.values()):
+                    # bezier curves bend between keys: the grid divided to 30 fps or finer
+                    dt = step / np.ceil(step * DEFAULT_FPS - 1e-9)
     else:
         dt = 1.0 / float(fps)
     count = int(round(clip.duration / dt)) + 1 if clip.duration > 0 else 1

@@ -81,3 +81,18 @@ def test_other_bezier_tracks_are_resampled_within_the_tolerance(tmp_path, case):
             errs.append(np.abs(x - y).max())
     # the tolerance holds at sample midpoints; between, a little more (2x covers it here)
     assert max(errs) < 2 * TOLERANCE[channel] + 1e-6
+
+
+def test_bvh_export_samples_bezier_curves_between_keys(tmp_path):
+    from rigedit.io.bvh_write import bvh_frame_times
+    rig = cylinder_rig()
+    clip = rig.clips["bend"]          # keys at 0, 0.5, 1: a BVH at the key rate has 3 frames
+    assert len(bvh_frame_times(clip)[0]) == 3
+    curves = clip.tracks[("j1", "rotation")].with_interpolation("bezier").curves
+    clip.set_track("j1", "rotation", Track.from_curves(
+        "rotation", [c.with_handle_type(range(3), "auto_clamped") for c in curves]))
+    times, dt = bvh_frame_times(clip)
+    assert dt == pytest.approx(0.5 / 15) and len(times) == 31
+    # the frames hold the curve's values (eased by the auto-clamped handles), not a line
+    z = [clip.sample(t).get_euler("j1", degrees=True)[2] for t in times[:16]]
+    assert z[3] < 60 * times[3] / 0.5 - 1 and z[15] == pytest.approx(60, abs=1e-6)
