@@ -15,7 +15,7 @@ from .io.data import RigData, RigMeta
 from .model import Pose, Skeleton, SkinBinding
 from .rig import Rig
 
-__all__ = ["load_rig", "save_rig", "retarget", "autorig", "resolve_rig_path", "BUNDLED",
+__all__ = ["load_rig", "save_rig", "retarget", "autorig", "compress", "resolve_rig_path", "BUNDLED",
            "ASSETS_DIR", "Rig", "RigData", "RigMeta", "Skeleton", "Pose", "Clip", "Track",
            "SkinBinding", "RigFileError"]
 __version__ = "0.1.0"
@@ -70,3 +70,31 @@ def save_rig(rig, path, clips=None):
     from .io.save import save_rig as _save_rig
 
     return _save_rig(rig, path, clips=clips)
+
+
+def compress(rig, max_error=1e-4, shell=0.03, clips=None, skin_shell=False, target="rigedit",
+             progress=None):
+    """Compress a rig's clips so no virtual vertex of any frame strays more than
+    ``max_error`` metres (see :func:`rigedit.compression.compress_clips`).
+
+    ``shell``: metres from each joint to its virtual vertices; ``skin_shell=True`` takes each
+    joint's from the rig's skin instead (its farthest vertex; the rig must have a mesh);
+    ``clips``: names (all when None; ``ValueError`` for a name the rig lacks).
+
+    Returns
+    -------
+    (dict[str, CompressedClip], CompressionReport)
+    """
+    from .compression import compress_clips
+
+    names = list(rig.clips) if clips is None else list(clips)
+    missing = [n for n in names if n not in rig.clips]
+    if missing:
+        raise ValueError(f"expected clip names of the rig ({', '.join(rig.clips) or 'none'}), "
+                         f"got {missing[0]!r}")
+    mesh = None
+    if skin_shell:
+        mesh = (rig.vertices, rig.binding.indices, rig.binding.weights)
+    result = compress_clips(rig.skeleton, {n: rig.clips[n] for n in names}, max_error=max_error,
+                            shell=shell, mesh=mesh, target=target, progress=progress)
+    return result.clips, result.report

@@ -1,0 +1,138 @@
+"""The decoder: whole poses at any time straight from the bit stream.
+
+What is decoded once, when a clip is opened: the headers and each track's key frames (times,
+a few bytes per key); the values stay packed. A pose at time ``t`` is then, for all animated
+tracks at once: one ``searchsorted`` over every track's key times (each track's times shifted
+by its own offset so one sorted array holds them all), the two neighbouring keys' fields read
+from the 32-bit words (two words per field, a shift and a mask), dequantised, the dropped
+rotation component rebuilt, LERP / NLERP on the shortest path, and a scatter into the pose
+array. A batch of N times runs the same operations on (N, tracks) arrays.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .bits import read_fields, words_of
+from .frames import COLUMNS
+from .quantise import OTHERS, PER_KEY
+
+__all__ = ["ClipDecoder"]
+
+
+class ClipDecoder:
+    """Samples one compressed clip.
+
+    Parameters
+    ----------
+    layout : ClipLayout
+        With decoded key frames (:func:`~rigedit.compression.layout.read_clip`).
+    stream : bytes
+    offsets : list of int
+        Bit offset of each animated track's values.
+    rest : (J, 10) float64
+        The skeleton's rest pose row (:meth:`Pose.as_array`): what tracks not stored hold.
+    """
+
+    def __init__(self, layout, stream, offsets, rest):
+        self.layout = layout
+        self.words = words_of(stream)
+        base = np.array(rest, dtype=np.float64)
+        for tr in layout.constant:
+            value = np.asarray(tr.value, dtype=np.float64)
+            if tr.channel == "rotation":
+                value = value / np.linalg.norm(value)
+            base[tr.joint, COLUMNS[tr.channel]] = value
+        self.base = base.reshape(-1)
+        self.num_joints = len(rest)
+        tracks = layout.animated
+        self.count = len(tracks)
+        times = layout.times
+        lengths = np.array([len(tr.keys) for tr in tracks], dtype=np.int64)
+        self.start = np.concatenate([[0], np.cumsum(lengths)[:-1]]).astype(np.int64)
+        self.last = self.start + lengths - 2          # the last segment's first key
+        span = float(times[-1] - times[0]) + 1.0 if len(times) else 1.0
+        self.shift = np.arange(self.count) * span
+        keys = [times[tr.keys] for tr in tracks]
+        self.key_times = np.concatenate(keys) if keys else np.zeros(0)
+        self.shifted = self.key_times + np.repeat(self.shift, lengths)
+        bits = np.array([tr.code.bits for tr in tracks], dtype=np.int64).reshape(-1, 3)
+        per_key = np.array([tr.mode == PER_KEY for tr in tracks], dtype=bool)
+        lead = np.where(per_key, 2, 0)
+        self.value_offset = np.asarray(offsets, dtype=np.int64)
+        self.stride = bits.sum(axis=1) + lead
+        self.field_offset = lead[:, None] + np.concatenate(
+            [np.zeros((self.count, 1), np.int64), np.cumsum(bits, axis=1)[:, :2]], axis=1)
+        self.bits = bits
+        lo = np.array([tr.code.lo for tr in tracks], dtype=np.float64).reshape(-1, 3)
+        ext = np.array([tr.code.ext for tr in tracks], dtype=np.float64).reshape(-1, 3)
+        levels = (np.left_shift(1, bits) - 1).astype(np.float64)
+        self.scale = np.where(levels > 0, ext / np.maximum(levels, 1), 0.0)
+        self.lo = np.where(levels > 0, lo, lo + ext / 2)
+        self.per_key = per_key
+        self.fixed = np.array([0 if tr.mode == PER_KEY else tr.mode for tr in tracks],
+                              dtype=np.int64)
+        rot = np.array([tr.channel == "rotation" for tr in tracks], dtype=bool)
+        self.rot = np.flatnonzero(rot)
+        self.vec = np.flatnonzero(~rot)
+        joint = np.array([tr.joint for tr in tracks], dtype=np.int64)
+        first = np.array([COLUMNS[tr.channel].start for tr in tracks], dtype=np.int64)
+        self.vec_target = (joint[self.vec] * 10 + first[self.vec])[:, None] + np.arange(3)
+        self.rot_target = (joint[self.rot] * 10 + 3)[:, None] + np.arange(4)
+        self.rot_per_key = per_key[self.rot]
+
+    def _interpolate(self, t):
+        """Values of every animated track at clip times ``t`` (N,): vectors (N, Tv, 3),
+        rotations (N, Tr, 4)."""
+        n = len(t)
+        pos = np.searchsorted(self.shifted, t[:, None] + self.shift[None, :], side="right") - 1
+        i = np.clip(pos, self.start, self.last)                       # (N, T)
+        t0, t1 = self.key_times[i], self.key_times[i + 1]
+        u = np.clip((t[:, None] - t0) / (t1 - t0), 0.0, 1.0)
+        key = (i - self.start)[..., None] + np.arange(2)              # (N, T, 2)
+        at = self.value_offset[:, None] + key * self.stride[:, None]  # (N, T, 2)
+        codes = read_fields(self.words, at[..., None] + self.field_offset[:, None, :],
+                            self.bits[:, None, :])                    # (N, T, 2, 3)
+        comps = self.lo[:, None, :] + codes * self.scale[:, None, :]
+        vec = comps[:, self.vec]
+        a, b = vec[:, :, 0], vec[:, :, 1]
+        uv = u[:, self.vec, None]
+        vectors = a + (b - a) * uv
+        three = comps[:, self.rot]                                    # (N, Tr, 2, 3)
+        dropped = np.broadcast_to(self.fixed[self.rot][:, None], (n, len(self.rot), 2))
+        if self.rot_per_key.any():
+            idx = read_fields(self.words, at[:, self.rot], 2).astype(np.int64)
+            dropped = np.where(self.rot_per_key[:, None], idx, dropped)
+        w = np.sqrt(np.maximum(1.0 - np.sum(three * three, axis=-1), 0.0))
+        q = np.empty(three.shape[:-1] + (4,))
+        np.put_along_axis(q, dropped[..., None], w[..., None], axis=-1)
+        np.put_along_axis(q, OTHERS[dropped], three, axis=-1)
+        qa, qb = q[:, :, 0], q[:, :, 1]
+        qb = np.where(np.sum(qa * qb, axis=-1, keepdims=True) < 0, -qb, qb)
+        rq = qa + (qb - qa) * u[:, self.rot, None]
+        rq /= np.linalg.norm(rq, axis=-1, keepdims=True)
+        return vectors, rq
+
+    def local_many(self, t):
+        """Local poses (N, J, 10) at clip times ``t`` (N,) (already wrapped or clamped)."""
+        t = np.asarray(t, dtype=np.float64).reshape(-1)
+        out = np.repeat(self.base[None], len(t), axis=0)
+        if self.count:
+            vectors, rotations = self._interpolate(t)
+            out[:, self.vec_target] = vectors
+            out[:, self.rot_target] = rotations
+        return out.reshape(len(t), self.num_joints, 10)
+
+    def keys(self, index):
+        """Key times (K,) and decoded values (K, C) of animated track ``index``."""
+        tr = self.layout.animated[index]
+        k = len(tr.keys)
+        at = self.value_offset[index] + np.arange(k) * self.stride[index]
+        codes = read_fields(self.words, at[:, None] + self.field_offset[index], self.bits[index])
+        comps = self.lo[index] + codes * self.scale[index]
+        times = self.key_times[self.start[index]:self.start[index] + k]
+        if tr.channel != "rotation":
+            return times, comps
+        dropped = (read_fields(self.words, at, 2).astype(np.int64) if self.per_key[index]
+                   else np.full(k, self.fixed[index]))
+        from .quantise import rotation_from_three
+        return times, rotation_from_three(comps, dropped)

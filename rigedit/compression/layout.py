@@ -1,0 +1,299 @@
+"""rigedit's compressed clip, byte by byte (docs/compression.md, "Binary layout").
+
+A clip is one blob, little-endian; ``varint`` is LEB128 (7 bits a byte, low first):
+
+====================  ======================================================================
+name                  varint n, n bytes UTF-8
+duration              float32 seconds
+flags                 uint8: bit 0 loop, bit 1 uniform frame times
+frames                varint F (frame count of the time grid, >= 1)
+time grid             uniform: float64 start, float64 period (frame i at start + i period);
+                      else F float32 times
+constant tracks       varint C, then C x (varint joint, uint8 channel, 3 or 4 float32)
+animated tracks       varint A, then A track headers:
+                      varint joint; uint8 channel (bits 0-1: 0 translation, 1 rotation,
+                      2 scale) | rotation mode << 2 (0-3 fixed dropped component, 4 per key);
+                      varint K (keys, 2..F); uint8 D (bits per key-frame step, 0: every
+                      frame is a key); per-key rotation: uint8 B (bits of all three
+                      components); else 3 uint8 bits, 3 float32 lo, 3 float32 extent
+bit stream            varint n words, n uint32 words: first every animated track's K - 1
+                      key-frame steps (D bits each; the first key is frame 0), then every
+                      animated track's K keys, each [2 bits dropped component, per-key
+                      rotations only] + 3 components of their bits
+====================  ======================================================================
+
+A component of b bits is ``lo + code * extent / (2^b - 1)``, of 0 bits ``lo + extent / 2``.
+Every count read is checked against the blob's size before anything is allocated for it.
+"""
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+
+import numpy as np
+
+from .bits import MAX_FIELD_BITS, pack
+from .quantise import PER_KEY, VectorCode
+
+__all__ = ["CHANNEL_CODES", "EncodedTrack", "ClipLayout", "write_clip", "read_clip",
+           "LayoutError"]
+
+CHANNEL_CODES = {"translation": 0, "rotation": 1, "scale": 2}
+CHANNEL_NAMES = {v: k for k, v in CHANNEL_CODES.items()}
+WIDTH = {"translation": 3, "rotation": 4, "scale": 3}
+
+
+class LayoutError(ValueError):
+    """A blob that is not a well-formed compressed clip (the message says what is wrong)."""
+
+
+@dataclass
+class EncodedTrack:
+    """One stored track: ``value`` (C,) float32 when constant; else ``keys`` (K,) frame
+    indices, ``mode`` (rotation: 0-3 or PER_KEY; 0 for vectors), ``code`` and, per-key
+    rotations, ``dropped`` (K,)."""
+
+    joint: int
+    channel: str
+    value: np.ndarray = None
+    keys: np.ndarray = None
+    mode: int = 0
+    code: VectorCode = None
+    dropped: np.ndarray = None
+
+
+@dataclass
+class ClipLayout:
+    """A clip as the blob holds it (see the module notes)."""
+
+    name: str
+    duration: float
+    loop: bool
+    times: np.ndarray          # (F,) float64 as decoded from the grid
+    uniform: tuple             # (start, period) or None
+    constant: list             # EncodedTrack
+    animated: list             # EncodedTrack
+
+
+def grid_times(count, uniform, times=None):
+    """The decoded frame times (F,) float64 of a grid."""
+    if uniform is not None:
+        start, period = uniform
+        return start + np.arange(count) * period
+    return np.asarray(times, dtype=np.float32).astype(np.float64)
+
+
+def _varint(n):
+    n = int(n)
+    out = bytearray()
+    while True:
+        byte = n & 0x7F
+        n >>= 7
+        if n:
+            out.append(byte | 0x80)
+        else:
+            out.append(byte)
+            return bytes(out)
+
+
+def write_clip(layout):
+    """The blob of a :class:`ClipLayout`, bytes."""
+    out = bytearray()
+    name = layout.name.encode("utf-8")
+    out += _varint(len(name)) + name
+    out += struct.pack("<fB", layout.duration, int(layout.loop) | (2 if layout.uniform else 0))
+    out += _varint(len(layout.times))
+    if layout.uniform:
+        out += struct.pack("<dd", *layout.uniform)
+    else:
+        out += np.asarray(layout.times, dtype="<f4").tobytes()
+    out += _varint(len(layout.constant))
+    for tr in layout.constant:
+        out += _varint(tr.joint) + bytes([CHANNEL_CODES[tr.channel]])
+        out += np.asarray(tr.value, dtype="<f4").tobytes()
+    out += _varint(len(layout.animated))
+    fields, widths = [], []
+    count = len(layout.times)
+    for tr in layout.animated:
+        keys = np.asarray(tr.keys, dtype=np.int64)
+        steps = np.diff(keys)
+        every = len(keys) == count
+        dbits = 0 if every else max(int(steps.max()).bit_length(), 1)
+        out += _varint(tr.joint) + bytes([CHANNEL_CODES[tr.channel] | (tr.mode << 2)])
+        out += _varint(len(keys)) + bytes([dbits])
+        if tr.mode == PER_KEY:
+            out += bytes([int(tr.code.bits[0])])
+        else:
+            out += bytes(int(b) for b in tr.code.bits)
+            out += np.asarray(tr.code.lo, dtype="<f4").tobytes()
+            out += np.asarray(tr.code.ext, dtype="<f4").tobytes()
+        if dbits:
+            fields.append(steps)
+            widths.append(np.full(len(steps), dbits))
+    for tr in layout.animated:
+        k = len(tr.keys)
+        bits = np.asarray(tr.code.bits, dtype=np.int64)
+        if tr.mode == PER_KEY:
+            per = np.column_stack([np.asarray(tr.dropped, dtype=np.uint64), tr.code.codes])
+            w = np.r_[2, bits]
+        else:
+            per, w = tr.code.codes, bits
+        fields.append(np.asarray(per, dtype=np.uint64).reshape(-1))
+        widths.append(np.tile(w, k))
+    stream = pack(np.concatenate(fields) if fields else np.zeros(0),
+                  np.concatenate(widths) if widths else np.zeros(0))
+    out += _varint(len(stream) // 4) + stream
+    return bytes(out)
+
+
+class _Reader:
+    """Reads a blob front to back; every read checked against its end."""
+
+    def __init__(self, blob):
+        self.blob, self.at = memoryview(blob), 0
+
+    def take(self, n, what):
+        if n < 0 or self.at + n > len(self.blob):
+            raise LayoutError(f"truncated clip data: {what} needs {n} bytes at byte "
+                              f"{self.at}, {len(self.blob) - self.at} left")
+        part = self.blob[self.at:self.at + n]
+        self.at += n
+        return part
+
+    def varint(self, what, limit):
+        n, shift = 0, 0
+        while True:
+            byte = self.take(1, what)[0]
+            n |= (byte & 0x7F) << shift
+            shift += 7
+            if not byte & 0x80:
+                break
+            if shift > 63:
+                raise LayoutError(f"{what}: a number longer than 9 bytes")
+        if n > limit:
+            raise LayoutError(f"{what}: {n}, expected at most {limit}")
+        return n
+
+    def u8(self, what):
+        return self.take(1, what)[0]
+
+    def floats(self, n, what, dtype="<f4"):
+        size = np.dtype(dtype).itemsize
+        return np.frombuffer(self.take(n * size, what), dtype=dtype).astype(np.float64)
+
+
+def read_clip(blob, num_joints):
+    """Parse a blob into a :class:`ClipLayout` and its bit stream.
+
+    Returns
+    -------
+    layout : ClipLayout
+        Animated tracks' ``code.codes`` are None (the values stay in the stream), their
+        ``keys`` decoded.
+    stream : bytes
+    value_offsets : list of int
+        Bit offset of each animated track's first key in the stream.
+
+    Raises
+    ------
+    LayoutError
+        Truncated data, a count beyond what the blob can hold, a joint index beyond
+        ``num_joints``, unknown codes, key steps that do not fit the frames.
+    """
+    r = _Reader(blob)
+    size = len(blob)
+    name = bytes(r.take(r.varint("clip name length", size), "clip name")).decode(
+        "utf-8", errors="replace")
+    duration, flags = struct.unpack("<fB", r.take(5, "duration and flags"))
+    if not np.isfinite(duration) or duration < 0:
+        raise LayoutError(f"clip {name!r}: duration {duration}, expected a finite number >= 0")
+    count = r.varint("frame count", size * 8)
+    if count < 1:
+        raise LayoutError(f"clip {name!r}: no frames")
+    if flags & 2:
+        start, period = struct.unpack("<dd", r.take(16, "frame grid"))
+        if not (np.isfinite(start) and np.isfinite(period)) or period < 0:
+            raise LayoutError(f"clip {name!r}: frame grid {start}, {period} not finite")
+        uniform, times = (start, period), grid_times(count, (start, period))
+    else:
+        uniform, times = None, r.floats(count, "frame times")
+        if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+            raise LayoutError(f"clip {name!r}: frame times not finite and increasing")
+    constant = []
+    for _ in range(r.varint("constant track count", size)):
+        joint = r.varint("joint index", num_joints - 1)
+        channel = CHANNEL_NAMES.get(r.u8("channel"))
+        if channel is None:
+            raise LayoutError(f"clip {name!r}: unknown channel code")
+        value = r.floats(WIDTH[channel], "constant value")
+        if not np.all(np.isfinite(value)) or (channel == "rotation"
+                                              and np.linalg.norm(value) < 1e-6):
+            raise LayoutError(f"clip {name!r}: a constant {channel} is not a finite value")
+        constant.append(EncodedTrack(joint, channel, value=value))
+    animated, dbits_all = [], []
+    for _ in range(r.varint("animated track count", size)):
+        joint = r.varint("joint index", num_joints - 1)
+        code = r.u8("channel")
+        channel, mode = CHANNEL_NAMES.get(code & 3), code >> 2
+        if channel is None or mode > PER_KEY or (channel != "rotation" and mode):
+            raise LayoutError(f"clip {name!r}: unknown track code {code}")
+        keys = r.varint("key count", count)
+        dbits = r.u8("key step bits")
+        if keys < 2 or count < 2 or dbits > 32 or (dbits == 0 and keys != count):
+            raise LayoutError(f"clip {name!r}: {keys} keys of {count} frames, step bits "
+                              f"{dbits}")
+        if mode == PER_KEY:
+            bits = np.full(3, r.u8("component bits"))
+            lo = np.full(3, -np.sqrt(0.5), dtype=np.float32)
+            ext = np.full(3, 2 * np.sqrt(0.5), dtype=np.float32)
+        else:
+            bits = np.frombuffer(r.take(3, "component bits"), dtype=np.uint8).astype(np.int64)
+            lo = r.floats(3, "range low").astype(np.float32)
+            ext = r.floats(3, "range extent").astype(np.float32)
+        if np.any(bits > MAX_FIELD_BITS) or not (np.all(np.isfinite(lo))
+                                                 and np.all(np.isfinite(ext))):
+            raise LayoutError(f"clip {name!r}: a track's range or bits are not valid")
+        animated.append(EncodedTrack(joint, channel, keys=keys, mode=mode,
+                                     code=VectorCode(lo, ext, np.asarray(bits), None)))
+        dbits_all.append(dbits)
+    words = r.varint("bit stream length", size // 4)
+    stream = bytes(r.take(words * 4, "bit stream"))
+    if r.at != size:
+        raise LayoutError(f"clip {name!r}: {size - r.at} bytes after the bit stream")
+    layout = ClipLayout(name, float(duration), bool(flags & 1), times, uniform, constant,
+                        animated)
+    return layout, stream, _key_frames(layout, stream, dbits_all)
+
+
+def _key_frames(layout, stream, dbits_all):
+    """Decode every animated track's key frames into ``track.keys`` and return each track's
+    value bit offset; checks the stream holds what the headers claim."""
+    from .bits import read_fields, words_of
+    count = len(layout.times)
+    need = 0
+    for tr, dbits in zip(layout.animated, dbits_all):
+        need += (tr.keys - 1) * dbits
+    offsets = []
+    value_bits = need
+    for tr in layout.animated:
+        stride = int(np.sum(tr.code.bits)) + (2 if tr.mode == PER_KEY else 0)
+        offsets.append(value_bits)
+        value_bits += tr.keys * stride
+    if value_bits > len(stream) * 8:
+        raise LayoutError(f"clip {layout.name!r}: the bit stream holds {len(stream) * 8} bits, "
+                          f"its tracks need {value_bits}")
+    words = words_of(stream)
+    at = 0
+    for tr, dbits in zip(layout.animated, dbits_all):
+        k = tr.keys
+        if dbits == 0:
+            tr.keys = np.arange(count)
+            continue
+        steps = read_fields(words, at + np.arange(k - 1) * dbits, dbits).astype(np.int64)
+        at += (k - 1) * dbits
+        keys = np.concatenate([[0], np.cumsum(steps)])
+        if np.any(steps <= 0) or keys[-1] != count - 1:
+            raise LayoutError(f"clip {layout.name!r}: key frames of a track do not run from "
+                              f"the first frame to the last")
+        tr.keys = keys
+    return offsets

@@ -1,0 +1,223 @@
+"""``compress_clips``: every clip of a skeleton compressed with a guaranteed error.
+
+Per clip: sample it at every frame (:mod:`.frames`), give each joint its share of the bound
+(:mod:`.budget`), drop or store once what does not move (:mod:`.constant`), quantise and
+reduce the rest (:mod:`.encode`), write the blob (:mod:`.layout`), decode it back
+(:mod:`.codec`) and measure every frame on virtual vertices in model space (:mod:`.error`).
+Where a joint is over the bound, the joints on its path to the root get half their share and
+are encoded again, until every frame of the clip holds.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..animation.clip import Clip
+from ..animation.track import Track
+from ..model.pose import Pose
+from ..progress import adapt
+from .budget import Budget
+from .compressed_clip import CompressedClip, KeyedClip
+from .encode import encode_track, gltf_track
+from .error import ErrorMeter
+from .frames import COLUMNS, frame_times
+from .layout import ClipLayout, grid_times, write_clip
+from .quantise import PER_KEY
+from .report import RAW_BYTES_PER_JOINT_FRAME, ClipRow, CompressionReport
+from .virtual import DEFAULT_SHELL, check_shell, shell_distances
+
+__all__ = ["TARGETS", "SECTION_BYTES", "CompressionResult", "compress_clips",
+           "check_max_error"]
+
+TARGETS = ("rigedit", "gltf")
+#: Bytes a clip's section header takes in a .rgc file (tag, length, CRC32), counted in the
+#: compressed size.
+SECTION_BYTES = 12
+#: Encodes per clip before giving up (each halves the offending joints' shares: 2^-16 of
+#: the bound is past float32's precision for anything but a microscopic bound).
+MAX_ATTEMPTS = 16
+_GLTF_MODE = {"translation": "linear", "rotation": "nlerp", "scale": "linear"}
+
+
+@dataclass
+class CompressionResult:
+    """``clips``: name -> :class:`CompressedClip` (``target="rigedit"``) or
+    :class:`KeyedClip` (``"gltf"``); ``report``: :class:`CompressionReport`."""
+
+    clips: dict
+    report: CompressionReport
+
+
+def check_max_error(max_error):
+    """``max_error`` as a positive finite float (metres); ``ValueError`` otherwise."""
+    try:
+        value = float(max_error)
+    except (TypeError, ValueError):
+        raise ValueError(f"expected max_error as a positive number of metres, got "
+                         f"{max_error!r}") from None
+    if not np.isfinite(value) or value <= 0:
+        raise ValueError(f"expected max_error as a positive finite number of metres, got "
+                         f"{max_error!r}")
+    return value
+
+
+def _grid(times):
+    """``(uniform, decoded times)``: a uniform grid (start, period) when the frames are evenly
+    spaced to 1e-7 s, else None and the float32 times."""
+    f = len(times)
+    period = float((times[-1] - times[0]) / (f - 1)) if f > 1 else 0.0
+    uniform = (float(times[0]), period)
+    grid = grid_times(f, uniform)
+    if np.max(np.abs(grid - times)) <= 1e-7:
+        return uniform, grid
+    return None, grid_times(f, None, times)
+
+
+def _kinds(layout, size):
+    """Compressed bytes per kind of one clip blob (section header included in ``header``)."""
+    kinds = dict.fromkeys(("rotation", "translation", "scale", "times", "header"), 0.0)
+    kinds["times"] += 0 if layout.uniform else 4 * len(layout.times)
+    for tr in layout.constant:
+        kinds[tr.channel] += 4 * len(tr.value)
+    frames = len(layout.times)
+    for tr in layout.animated:
+        k = len(tr.keys)
+        stride = int(np.sum(tr.code.bits)) + (2 if tr.mode == PER_KEY else 0)
+        kinds[tr.channel] += k * stride / 8
+        if k != frames:
+            kinds["times"] += (k - 1) * max(int(np.diff(tr.keys).max()).bit_length(), 1) / 8
+    kinds = {k: int(round(v)) for k, v in kinds.items()}
+    kinds["header"] = size - sum(v for k, v in kinds.items() if k != "header")
+    return kinds
+
+
+def _compress_one(skeleton, clip, max_error, distances, target, shell, mesh):
+    """One clip: ``(compressed clip, (F, J) errors, ClipRow)``."""
+    times = frame_times(clip)
+    meter = ErrorMeter(skeleton, clip, times, shell, mesh)
+    budget = Budget(skeleton, max_error, distances)
+    uniform, grid = _grid(times)
+    ref = meter.local
+    rest = Pose(skeleton).as_array()
+    sources = [(skeleton.index[name], channel) for name, channel in clip.tracks]
+    cache = {}
+    for attempt in range(1, MAX_ATTEMPTS + 1):
+        stored = {}
+        for j, channel in sources:
+            tol = budget.tolerance(j, channel)
+            hit = cache.get((j, channel))
+            if hit is None or hit[0] != tol:
+                cols = COLUMNS[channel]
+                encode = encode_track if target == "rigedit" else gltf_track
+                args = (ref[:, j, cols], rest[j, cols], tol, grid)
+                hit = cache[(j, channel)] = (tol, encode(j, channel, *args) if
+                                             target == "rigedit" else encode(channel, *args))
+            if hit[1] is not None:
+                stored[(j, channel)] = hit[1]
+        compressed = (_rigedit_clip if target == "rigedit" else _gltf_clip)(
+            skeleton, clip, stored, uniform, grid)
+        err = meter.error(compressed)
+        if err.max() <= max_error:
+            break
+        budget.tighten(np.flatnonzero(err.max(axis=0) > max_error))
+    else:
+        raise ValueError(f"clip {clip.name!r}: cannot hold max_error {max_error:g} m (still "
+                         f"{err.max():.3g} m after {MAX_ATTEMPTS} encodes)")
+    return compressed, err, _row(clip, compressed, err, len(times), attempt, len(sources),
+                                 skeleton)
+
+
+def _row(clip, compressed, err, frames, attempts, sources, skeleton):
+    size = compressed.nbytes + SECTION_BYTES
+    if isinstance(compressed, CompressedClip):
+        layout = compressed.layout
+        animated, constant = len(layout.animated), len(layout.constant)
+        keys = sum(len(tr.keys) for tr in layout.animated)
+        kinds = _kinds(layout, size)
+    else:
+        tracks = compressed.clip.tracks.values()
+        constant = sum(len(tr) == 1 for tr in tracks)
+        animated = len(tracks) - constant
+        keys = sum(len(tr) for tr in tracks if len(tr) > 1)
+        kinds = compressed.kinds
+    return ClipRow(clip.name, frames, len(skeleton), float(err.max()),
+                   float(np.percentile(err, 99)), frames * len(skeleton) *
+                   RAW_BYTES_PER_JOINT_FRAME, size, kinds,
+                   {"animated": animated, "constant": constant,
+                    "omitted": sources - animated - constant}, keys, attempts)
+
+
+def _rigedit_clip(skeleton, clip, stored, uniform, grid):
+    constant = [tr for tr in stored.values() if tr.keys is None]
+    animated = [tr for tr in stored.values() if tr.keys is not None]
+    layout = ClipLayout(clip.name, float(np.float32(clip.duration)), clip.loop, grid, uniform,
+                        constant, animated)
+    return CompressedClip(skeleton, write_clip(layout))
+
+
+def _gltf_clip(skeleton, clip, stored, uniform, grid):
+    tracks, kinds = {}, dict.fromkeys(("rotation", "translation", "scale", "times",
+                                       "header"), 0)
+    for (j, channel), (times, values) in stored.items():
+        tracks[(skeleton.names[j], channel)] = Track(channel, times.astype(np.float32),
+                                                     values, _GLTF_MODE[channel])
+        kinds[channel] += len(times) * (8 if channel == "rotation" else 12)
+        kinds["times"] += 4 * len(times)
+    keyed = KeyedClip(Clip(clip.name, skeleton, tracks, clip.duration, clip.loop),
+                      sum(kinds.values()))
+    keyed.kinds = kinds
+    return keyed
+
+
+def compress_clips(skeleton, clips, max_error=1e-4, shell=DEFAULT_SHELL, mesh=None,
+                   target="rigedit", progress=None):
+    """Compress clips so that no virtual vertex of any frame strays more than ``max_error``.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+    clips : dict[str, Clip]
+    max_error : float
+        Metres (model space), > 0.
+    shell : float
+        Metres from each joint to its virtual vertices (ACL's 3 cm by default).
+    mesh : (vertices (V, 3), indices (V, K), weights (V, K)), optional
+        The rig's skin at bind: each joint's shell from its farthest vertex.
+    target : {"rigedit", "gltf"}
+        ``rigedit``: rigedit's own format, everything quantised (:class:`CompressedClip`);
+        ``gltf``: what glTF's core holds (float32 times, translations and scales; rotations
+        on the normalised int16 grid), reduced keys (:class:`KeyedClip`).
+    progress : callable(fraction, stage), optional
+
+    Returns
+    -------
+    CompressionResult
+        ``report.max_error`` never exceeds ``max_error``: every frame is checked after
+        decoding.
+
+    Raises
+    ------
+    ValueError
+        ``max_error`` or ``shell`` not a positive finite number, an unknown target, or a
+        bound no encoding reaches.
+    """
+    max_error = check_max_error(max_error)
+    shell = check_shell(shell)
+    if target not in TARGETS:
+        raise ValueError(f"expected target in {TARGETS}, got {target!r}")
+    progress = adapt(progress, "compress")
+    start = time.perf_counter()
+    distances = shell_distances(skeleton, shell, mesh)
+    report = CompressionReport(max_error, shell, target)
+    out, errors = {}, []
+    clips = dict(clips)
+    for i, (name, clip) in enumerate(clips.items()):
+        progress(i / max(len(clips), 1), f"compress {name}")
+        out[name], err, row = _compress_one(skeleton, clip, max_error, distances, target,
+                                            shell, mesh)
+        errors.append(err)
+        report.clips.append(row)
+    progress(1.0, "compress")
+    return CompressionResult(out, report.finish(errors, time.perf_counter() - start))
