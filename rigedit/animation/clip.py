@@ -41,7 +41,7 @@ class Clip:
         self.morph_tracks = {}
         self.loop = bool(loop)
         self.revision = 0
-        self._bezier = None   # (revision, BezierTracks): the bezier tracks packed for sample
+        self._bezier = None   # (revision, skeleton, BezierTracks): tracks split for sample
         for (joint, channel), track in (tracks or {}).items():
             self.set_track(joint, channel, track)
         for target, track in (morph_tracks or {}).items():
@@ -267,23 +267,21 @@ class Clip:
         if out is not None:
             pose.reset()
         t = self.local_time(t)
-        index = self.skeleton.index
-        bezier = self.bezier_tracks()
-        for (joint, channel), track in self.tracks.items():
-            if track.curves is None:
-                getattr(pose, channel)[index[joint]] = track.sample(t)
-        if len(bezier):
-            for (joint, channel), value in bezier.sample(t):
-                getattr(pose, channel)[index[joint]] = value
+        split = self.bezier_tracks()
+        for row, channel, track in split.plain:
+            getattr(pose, channel)[row] = track.sample(t)
+        split.write(pose, t)
         return pose
 
     def bezier_tracks(self):
-        """The clip's bezier tracks packed for sampling them in one call
-        (:class:`~rigedit.animation.curve_pack.BezierTracks`), rebuilt when :attr:`revision`
-        changed."""
-        if self._bezier is None or self._bezier[0] != self.revision:
-            self._bezier = (self.revision, BezierTracks(self.tracks))
-        return self._bezier[1]
+        """The clip's tracks split for sampling: the bezier ones packed to be sampled in one
+        call (:class:`~rigedit.animation.curve_pack.BezierTracks`), rebuilt when
+        :attr:`revision` changed."""
+        got = self._bezier
+        if got is None or got[0] != self.revision or got[1] is not self.skeleton:
+            got = self._bezier = (self.revision, self.skeleton,
+                                  BezierTracks(self.tracks, self.skeleton.index))
+        return got[2]
 
     def copy(self, name=None):
         return Clip(name or self.name, self.skeleton,

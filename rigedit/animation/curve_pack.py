@@ -6,7 +6,7 @@ a loaded machine), so a 60-joint pose of bezier tracks would take tens of millis
 segment with one ``searchsorted`` (each curve's keys shifted into its own time window) and
 evaluates all segments together (:func:`~rigedit.animation.curve.evaluate`). A
 :class:`BezierTracks` packs a clip's bezier tracks and converts their rotations from Euler
-angles with one scipy call per Euler order. :class:`~rigedit.animation.clip.Clip` keeps one,
+angles in one call per Euler order, writing each pose field with one indexed assignment. :class:`~rigedit.animation.clip.Clip` keeps one,
 rebuilt when its ``revision`` changes.
 """
 from __future__ import annotations
@@ -69,32 +69,45 @@ class CurvePack:
 
 
 class BezierTracks:
-    """A clip's bezier tracks, sampled together.
+    """A clip's tracks split for sampling: the bezier ones packed together, the others kept
+    as a list.
 
     Parameters
     ----------
     tracks : dict[(str, str), Track]
-        Only the ``bezier`` ones are taken.
+    index : dict[str, int]
+        Joint name -> pose row (the skeleton's ``index``).
     """
 
-    def __init__(self, tracks):
-        self.keys = [k for k, tr in tracks.items() if tr.curves is not None]
-        chosen = [tracks[k] for k in self.keys]
+    def __init__(self, tracks, index):
+        self.plain = [(index[j], c, tr) for (j, c), tr in tracks.items() if tr.curves is None]
+        keys = [k for k, tr in tracks.items() if tr.curves is not None]
+        chosen = [tracks[k] for k in keys]
         self.pack = CurvePack([c for tr in chosen for c in tr.curves])
-        self.orders = {}
-        for i, tr in enumerate(chosen):
-            if tr.channel == "rotation":
-                self.orders.setdefault(tr.euler_order, []).append(i)
+        # per pose field, the pose rows and the pack rows (tracks) that fill them
+        self.vectors = []
+        for channel in ("translation", "scale"):
+            rows = [i for i, k in enumerate(keys) if k[1] == channel]
+            if rows:
+                self.vectors.append((channel, np.array([index[keys[i][0]] for i in rows]),
+                                     np.array(rows)))
+        self.rotations = []
+        for order in sorted({tr.euler_order for tr in chosen if tr.channel == "rotation"}):
+            rows = [i for i, k in enumerate(keys)
+                    if k[1] == "rotation" and chosen[i].euler_order == order]
+            self.rotations.append((order, np.array([index[keys[i][0]] for i in rows]),
+                                   np.array(rows)))
+        self.count = len(keys)
 
     def __len__(self):
-        return len(self.keys)
+        return self.count
 
-    def sample(self, t):
-        """``[(key, value)]`` of every bezier track at clip time ``t``: (3,) translations and
-        scales, (4,) unit quaternions."""
+    def write(self, pose, t):
+        """Set the pose's values of every bezier track at clip time ``t``."""
+        if not self.count:
+            return
         v = self.pack.sample(t).reshape(-1, 3)
-        values = list(v)
-        for order, rows in self.orders.items():
-            for i, q in zip(rows, euler_to_quat(v[rows], order)):
-                values[i] = q
-        return list(zip(self.keys, values))
+        for channel, joints, rows in self.vectors:
+            getattr(pose, channel)[joints] = v[rows]
+        for order, joints, rows in self.rotations:
+            pose.rotation[joints] = euler_to_quat(v[rows], order)

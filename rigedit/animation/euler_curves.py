@@ -31,6 +31,16 @@ def _check(order):
     return [("XYZ".index(a)) for a in order]
 
 
+def _quat_mul(a, b):
+    """(N, 4) Hamilton products ``a b`` of quaternions x, y, z, w."""
+    ax, ay, az, aw = a.T
+    bx, by, bz, bw = b.T
+    return np.stack([aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw,
+                     aw * bw - ax * bx - ay * by - az * bz], axis=1)
+
+
 def euler_to_quat(angles, order=DEFAULT_ORDER):
     """Quaternions (x, y, z, w) of Euler angles.
 
@@ -43,10 +53,21 @@ def euler_to_quat(angles, order=DEFAULT_ORDER):
     Returns
     -------
     quats : (N, 4) or (4,) float
+        The product of the three axis rotations, the first axis of ``order`` applied first
+        (scipy's ``from_euler(order.lower(), ...)``; written out because scipy's per-call
+        overhead is most of a pose's sampling time).
     """
     axes = _check(order)
     a = np.asarray(angles, dtype=np.float64)
-    return Rotation.from_euler(order.lower(), a[..., axes], degrees=True).as_quat()
+    flat = a.reshape(-1, 3)
+    half = np.radians(flat) / 2
+    c, s = np.cos(half), np.sin(half)
+    q = None
+    for axis in axes:   # extrinsic: each later rotation multiplies from the left
+        r = np.zeros((len(flat), 4))
+        r[:, axis], r[:, 3] = s[:, axis], c[:, axis]
+        q = r if q is None else _quat_mul(r, q)
+    return q.reshape(a.shape[:-1] + (4,))
 
 
 def _nearest_turn(angles, reference):
