@@ -109,3 +109,37 @@ def test_a_task_whose_worker_dies_twice_is_recorded_lost(tmp_path):
     assert entry["status"] == "failed" and entry["failure"] == "lost"
     assert "died" in entry["error"] and "\n" not in entry["error"]
     assert time.monotonic() - t0 < 60
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_the_workers_and_leaves_a_consistent_manifest(tmp_path):
+    import psutil
+
+    make_motions(tmp_path / "in", 24)
+    out = tmp_path / "out"
+    batch = subprocess.Popen(RIGEDIT + ["batch", "retarget", str(tmp_path / "in"), "--to",
+                                        "humanoid", "-o", str(out), "--workers", "2",
+                                        "--no-thumbnails"],
+                             cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    end = time.monotonic() + 90
+    while len(list((out / "manifest").glob("*.json"))) < 3:
+        assert batch.poll() is None and time.monotonic() < end, batch.communicate()
+        time.sleep(0.05)
+    children = psutil.Process(batch.pid).children(recursive=True)
+    assert len(children) >= 2   # the workers (and their nannies)
+    batch.send_signal(signal.SIGINT)
+    t0 = time.monotonic()
+    stdout, stderr = batch.communicate(timeout=60)
+    assert batch.returncode == 130, stderr
+    assert time.monotonic() - t0 < 20
+    assert "interrupted by SIGINT" in stderr and "Traceback" not in stderr
+    assert psutil.wait_procs(children, timeout=10)[1] == []   # every worker ended
+    entries = sorted((out / "manifest").glob("*.json"))
+    assert 3 <= len(entries) < 24
+    for path in entries:
+        entry = json.loads(path.read_text())
+        assert entry["status"] == "ok" and (out / entry["outputs"][0]).is_file()
+    index = json.loads((out / "manifest.json").read_text())["tasks"]
+    assert len(index) == len(entries)
+    assert litter(out) == []
+    assert "not run (the batch was stopped)" in (out / "report.html").read_text()
