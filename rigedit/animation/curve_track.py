@@ -49,7 +49,7 @@ def _slopes(track, euler, euler_order):
     eps = 1e-4 * span
     out = np.empty((len(times), 2, 3))
     for side, sign in ((0, -1.0), (1, 1.0)):
-        near = np.array([track.sample(t + sign * eps) for t in times])
+        near = track.sample_many(times + sign * eps)
         angles = nearest(principal(near, euler_order), euler_order, euler)
         out[:, side] = sign * (angles - euler) / eps
     # the end keys' outer sides are clamped (no motion beyond the keys): reuse the inner one

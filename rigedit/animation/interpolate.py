@@ -49,7 +49,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["MODES", "VECTOR_MODES", "ROTATION_MODES", "HYBRID_THRESHOLD", "segment",
-           "sample_track", "lerp", "nlerp", "slerp", "hybrid", "catmull_rom_tangents",
+           "sample_track", "sample_many", "lerp", "nlerp", "slerp", "hybrid", "catmull_rom_tangents",
            "hermite"]
 
 VECTOR_MODES = ("step", "linear", "catmull_rom", "cubic_spline")
@@ -219,3 +219,53 @@ def sample_track(times, values, t, mode, rotation, tangents=None):
     if rotation:
         return _ROT[mode](values[i], values[k], u)
     return lerp(values[i], values[k], u)
+
+
+def sample_many(times, values, ts, mode, rotation, tangents=None):
+    """Values of a track at many times at once: :func:`sample_track` vectorised.
+
+    Parameters
+    ----------
+    times : (K,) float64, sorted
+    values : (K, C) float64
+    ts : (N,) float
+    mode, rotation, tangents
+        As for :func:`sample_track` (``catmull_rom`` needs its baked tangents here).
+
+    Returns
+    -------
+    values : (N, C) float64
+    """
+    ts = np.clip(np.asarray(ts, dtype=np.float64).reshape(-1), times[0], times[-1])
+    if len(times) == 1:
+        out = np.repeat(values[:1], len(ts), axis=0)
+        return out / np.linalg.norm(out, axis=1, keepdims=True) if rotation else out
+    i = np.clip(np.searchsorted(times, ts, side="right") - 1, 0, len(times) - 2)
+    dt = times[i + 1] - times[i]
+    u = ((ts - times[i]) / dt)[:, None]
+    a, b = values[i], values[i + 1]
+    if mode == "step":
+        out = np.where(u >= 1, b, a)
+    elif mode in ("catmull_rom", "cubic_spline"):
+        m0 = tangents[i] if mode == "catmull_rom" else tangents[i, 1]
+        m1 = tangents[i + 1] if mode == "catmull_rom" else tangents[i + 1, 0]
+        out = hermite(a, b, m0, m1, dt[:, None], u)
+    elif not rotation:
+        out = a + (b - a) * u
+    else:
+        d = np.sum(a * b, axis=1, keepdims=True)
+        b, d = np.where(d < 0, -b, b), np.abs(d)
+        out = a + (b - a) * u                                   # nlerp, normalised below
+        theta = np.arccos(np.clip(d, -1, 1))
+        use = d[:, 0] <= 1.0 - 1e-10
+        if mode == "hybrid":
+            use &= 2 * theta[:, 0] > HYBRID_THRESHOLD
+        elif mode not in ("slerp",):
+            use[:] = False
+        if use.any():
+            s = np.sin(theta[use])
+            out[use] = (np.sin((1 - u[use]) * theta[use]) / s) * a[use] \
+                + (np.sin(u[use] * theta[use]) / s) * b[use]
+    if rotation:
+        out = out / np.linalg.norm(out, axis=1, keepdims=True)
+    return out

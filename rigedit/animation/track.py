@@ -6,7 +6,8 @@ import numpy as np
 from .curve import Curve
 from .curve_track import curves_from_track, remove_times, retime
 from .euler_curves import DEFAULT_ORDER, EULER_ORDERS, euler_to_quat, quat_to_euler
-from .interpolate import ROTATION_MODES, VECTOR_MODES, catmull_rom_tangents, sample_track
+from .interpolate import (ROTATION_MODES, VECTOR_MODES, catmull_rom_tangents, sample_many,
+                          sample_track)
 
 __all__ = ["CHANNELS", "DEFAULT_MODE", "KEY_TOLERANCE", "Track", "curves_from_track"]
 
@@ -167,6 +168,14 @@ class Track:
             return self.curve_values(np.array([float(t)]))[0]
         return sample_track(self.times, self.values, t, self.interpolation,
                             self.channel == "rotation", self.tangents)
+
+    def sample_many(self, ts):
+        """(N, C) values at times ``ts`` (N,), each clamped to the first and last key: one
+        vectorised call (:func:`~rigedit.animation.interpolate.sample_many`)."""
+        if self.curves is not None:
+            return self.curve_values(np.clip(ts, self.times[0], self.times[-1]))
+        return sample_many(self.times, self.values, ts, self.interpolation,
+                           self.channel == "rotation", self.tangents)
 
     def key_index(self, t, tol=KEY_TOLERANCE):
         """Index of the key within ``tol`` seconds of ``t``, or None."""

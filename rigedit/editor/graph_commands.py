@@ -96,7 +96,7 @@ class ChannelView:
             return np.full(len(times), np.nan)
         if self.bezier:
             return self.curve.sample(times)
-        values = np.array([self.track.sample(t) for t in times])
+        values = self.track.sample_many(times)
         if self.id.channel == "rotation":
             ref = _track_curves(self.track)
             values = quat_to_euler(values, DEFAULT_ORDER, [c.sample(times[0]) for c in ref])

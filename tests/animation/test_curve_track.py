@@ -10,6 +10,7 @@ from rigedit.animation.curve import Curve
 from rigedit.animation.curve_pack import CurvePack
 from rigedit.animation.curve_track import curves_from_track
 from rigedit.animation.euler_curves import EULER_ORDERS, euler_to_quat, quat_to_euler
+from rigedit.animation.interpolate import ROTATION_MODES, VECTOR_MODES
 
 TIMES = np.arange(9) * 0.25
 
@@ -122,3 +123,22 @@ def test_a_bezier_track_needs_three_curves():
         Track("translation", [0], [[0, 0, 0]], "bezier")
     with pytest.raises(ValueError, match="Euler order"):
         Track.from_curves("rotation", [Curve([0], [1])] * 3, "XYX")
+
+
+@pytest.mark.parametrize("channel, mode", [("rotation", m) for m in ROTATION_MODES]
+                         + [("translation", m) for m in VECTOR_MODES])
+def test_sample_many_equals_sample_per_time(channel, mode):
+    rng = np.random.default_rng(6)
+    times = np.array([0, 0.3, 0.5, 1.2, 1.3])
+    values = (Rotation.random(5, random_state=2).as_quat() if channel == "rotation"
+              else rng.normal(size=(5, 3)))
+    track = Track(channel, times, values, mode)
+    ts = np.linspace(-0.2, 1.5, 171)
+    np.testing.assert_allclose(track.sample_many(ts), [track.sample(t) for t in ts],
+                               atol=1e-12)
+    bezier = track.with_interpolation("bezier")
+    many, one = bezier.sample_many(ts), np.array([bezier.sample(t) for t in ts])
+    if channel == "rotation":   # the same rotations (a quaternion's sign is free)
+        np.testing.assert_allclose(np.abs(np.sum(many * one, axis=1)), 1, atol=1e-12)
+    else:
+        np.testing.assert_allclose(many, one, atol=1e-12)
