@@ -16,7 +16,30 @@ from .bits import read_fields, words_of
 from .frames import COLUMNS
 from .quantise import OTHERS, PER_KEY
 
-__all__ = ["ClipDecoder"]
+__all__ = ["ClipDecoder", "kernels", "kernels_loaded"]
+
+_KERNELS = []
+
+
+def kernels_loaded():
+    """True once :func:`kernels` has imported the compiled kernels."""
+    return bool(_KERNELS) and _KERNELS[0] is not None
+
+
+def kernels():
+    """The compiled decode kernels (:mod:`.codec_kernels`), imported and compiled (or loaded
+    from numba's disk cache) on the first call; None when numba is missing or
+    ``RIGEDIT_NO_NUMBA=1``."""
+    if not _KERNELS:
+        import os
+        module = None
+        if os.environ.get("RIGEDIT_NO_NUMBA", "") in ("", "0"):
+            try:
+                from . import codec_kernels as module
+            except ImportError:
+                module = None
+        _KERNELS.append(module)
+    return _KERNELS[0]
 
 
 class ClipDecoder:
@@ -79,6 +102,27 @@ class ClipDecoder:
         self.vec_target = (joint[self.vec] * 10 + first[self.vec])[:, None] + np.arange(3)
         self.rot_target = (joint[self.rot] * 10 + 3)[:, None] + np.arange(4)
         self.rot_per_key = per_key[self.rot]
+        self.itab = np.column_stack([
+            self.start, lengths, self.value_offset, self.stride, lead, bits,
+            rot.astype(np.int64), joint * 10 + first, self.fixed]).astype(np.int64) \
+            if self.count else np.zeros((0, 11), dtype=np.int64)
+        self.ftab = np.ascontiguousarray(np.column_stack([self.lo, self.scale])) \
+            if self.count else np.zeros((0, 6))
+        self.compiled = None
+
+    def use_kernels(self, on=True):
+        """Decode with the compiled kernels (when numba is there) or with numpy."""
+        self.compiled = kernels() if on else None
+        return self.compiled is not None
+
+    def pose_into(self, t, out):
+        """One pose at clip time ``t`` into ``out`` (J * 10,) float64."""
+        if self.compiled is not None:
+            self.compiled.pose_at(float(t), self.itab, self.ftab, self.key_times, self.words,
+                                  self.base, out)
+        else:
+            out[:] = self.local_many(np.array([float(t)])).reshape(-1)
+        return out
 
     def _interpolate(self, t):
         """Values of every animated track at clip times ``t`` (N,): vectors (N, Tv, 3),
@@ -115,6 +159,11 @@ class ClipDecoder:
     def local_many(self, t):
         """Local poses (N, J, 10) at clip times ``t`` (N,) (already wrapped or clamped)."""
         t = np.asarray(t, dtype=np.float64).reshape(-1)
+        if self.compiled is not None:
+            out = np.empty((len(t), len(self.base)))
+            self.compiled.poses_at(t, self.itab, self.ftab, self.key_times, self.words,
+                                   self.base, out)
+            return out.reshape(len(t), self.num_joints, 10)
         out = np.repeat(self.base[None], len(t), axis=0)
         if self.count:
             vectors, rotations = self._interpolate(t)

@@ -6,7 +6,7 @@ import numpy as np
 from ..animation.clip import Clip
 from ..animation.track import Track
 from ..model.pose import Pose
-from .codec import ClipDecoder
+from .codec import ClipDecoder, kernels_loaded
 from .frames import local_times, sample_local
 from .layout import read_clip
 
@@ -57,11 +57,30 @@ class CompressedClip(_Sampled):
         self.name, self.duration, self.loop = layout.name, layout.duration, layout.loop
         self.revision = 0
         self.decoder = ClipDecoder(layout, stream, offsets, Pose(skeleton).as_array())
+        self._row = np.empty(len(skeleton) * 10)
+        self._first = True
+        if kernels_loaded():
+            self.decoder.use_kernels()
 
     @property
     def nbytes(self):
         """Size of the compressed clip, bytes."""
         return len(self.blob)
+
+    def use_kernels(self, on=True):
+        """Decode with numba's compiled kernels (imported on the first call; the numpy
+        decoder otherwise). Returns whether they are in use."""
+        return self.decoder.use_kernels(on)
+
+    def sample(self, t, out=None):
+        """The pose at playback time ``t`` (wrapped or clamped as :meth:`Clip.sample`)."""
+        pose = Pose(self.skeleton) if out is None else out
+        if self._first:   # playback: worth the compiled decoder (imported once, ~1 s)
+            self._first = False
+            self.decoder.use_kernels()
+        self.decoder.pose_into(self.local_time(t), self._row)
+        pose.set_array(self._row.reshape(-1, 10))
+        return pose
 
     def sample_many(self, times):
         """Local poses (N, J, 10) at playback times (N,), one decode for all of them."""

@@ -4,7 +4,7 @@ A clip is one blob, little-endian; ``varint`` is LEB128 (7 bits a byte, low firs
 
 ====================  ======================================================================
 name                  varint n, n bytes UTF-8
-duration              float32 seconds
+duration              float64 seconds (a looping clip wraps at it: exactly the source's)
 flags                 uint8: bit 0 loop, bit 1 uniform frame times
 frames                varint F (frame count of the time grid, >= 1)
 time grid             uniform: float64 start, float64 period (frame i at start + i period);
@@ -101,7 +101,7 @@ def write_clip(layout):
     out = bytearray()
     name = layout.name.encode("utf-8")
     out += _varint(len(name)) + name
-    out += struct.pack("<fB", layout.duration, int(layout.loop) | (2 if layout.uniform else 0))
+    out += struct.pack("<dB", layout.duration, int(layout.loop) | (2 if layout.uniform else 0))
     out += _varint(len(layout.times))
     if layout.uniform:
         out += struct.pack("<dd", *layout.uniform)
@@ -204,7 +204,7 @@ def read_clip(blob, num_joints):
     size = len(blob)
     name = bytes(r.take(r.varint("clip name length", size), "clip name")).decode(
         "utf-8", errors="replace")
-    duration, flags = struct.unpack("<fB", r.take(5, "duration and flags"))
+    duration, flags = struct.unpack("<dB", r.take(9, "duration and flags"))
     if not np.isfinite(duration) or duration < 0:
         raise LayoutError(f"clip {name!r}: duration {duration}, expected a finite number >= 0")
     count = r.varint("frame count", size * 8)

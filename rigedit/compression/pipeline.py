@@ -152,7 +152,7 @@ def _row(clip, compressed, err, frames, attempts, sources, skeleton):
 def _rigedit_clip(skeleton, clip, stored, uniform, grid):
     constant = [tr for tr in stored.values() if tr.keys is None]
     animated = [tr for tr in stored.values() if tr.keys is not None]
-    layout = ClipLayout(clip.name, float(np.float32(clip.duration)), clip.loop, grid, uniform,
+    layout = ClipLayout(clip.name, float(clip.duration), clip.loop, grid, uniform,
                         constant, animated)
     return CompressedClip(skeleton, write_clip(layout))
 

@@ -1,0 +1,110 @@
+"""The decoder's compiled kernels (numba): one pose, or a batch of poses, straight from the
+packed words, one loop over the animated tracks (a binary search in the track's key times,
+two keys' fields read, dequantised, the dropped component rebuilt, LERP / NLERP).
+
+Imported only by :func:`rigedit.compression.codec.kernels` (which imports numba through
+this module, once, on first use, and caches the compiled code on disk with
+``cache=True``); :class:`~rigedit.compression.codec.ClipDecoder`'s numpy path is the
+reference and the fallback (``RIGEDIT_NO_NUMBA=1``). The tables are built by the decoder:
+
+``itab`` (T, 11) int64 per animated track: key start, key count, value bit offset, stride,
+lead bits (2 for per-key rotations), the three component bits, is-rotation, target column
+(joint * 10 + first column), fixed dropped component; ``ftab`` (T, 6) float64: lo (3),
+scale (3).
+"""
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+__all__ = ["pose_at", "poses_at"]
+
+_OTHERS = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]], dtype=np.int64)
+
+
+@numba.njit(cache=True, inline="always")
+def _field(words, pos, bits):
+    w = pos >> 5
+    pair = words[w] | (words[w + 1] << np.uint64(32))
+    return (pair >> np.uint64(pos & 31)) & ((np.uint64(1) << np.uint64(bits)) - np.uint64(1))
+
+
+@numba.njit(cache=True)
+def _decode_key(words, itab, ftab, k, key, others, q):
+    """Key ``key`` of track ``k`` into q[0:3] (vector) or q[0:4] (rotation)."""
+    pos = itab[k, 2] + key * itab[k, 3]
+    lead = itab[k, 4]
+    dropped = itab[k, 10]
+    if lead:
+        dropped = np.int64(_field(words, pos, 2))
+    pos += lead
+    rotation = itab[k, 8] != 0
+    w2 = 1.0
+    for m in range(3):
+        bits = itab[k, 5 + m]
+        c = ftab[k, m] + np.float64(_field(words, pos, bits)) * ftab[k, 3 + m]
+        pos += bits
+        if rotation:
+            q[others[dropped, m]] = c
+            w2 -= c * c
+        else:
+            q[m] = c
+    if rotation:
+        q[dropped] = np.sqrt(w2) if w2 > 0 else 0.0
+
+
+@numba.njit(cache=True)
+def _pose(t, itab, ftab, key_times, words, others, out, a, b):
+    for k in range(itab.shape[0]):
+        lo = itab[k, 0]
+        hi = lo + itab[k, 1] - 1
+        if t <= key_times[lo]:
+            i, u = lo, 0.0
+        elif t >= key_times[hi]:
+            i, u = hi - 1, 1.0
+        else:
+            while hi - lo > 1:
+                mid = (lo + hi) >> 1
+                if key_times[mid] <= t:
+                    lo = mid
+                else:
+                    hi = mid
+            i = lo
+            u = (t - key_times[i]) / (key_times[i + 1] - key_times[i])
+        key = i - itab[k, 0]
+        _decode_key(words, itab, ftab, k, key, others, a)
+        _decode_key(words, itab, ftab, k, key + 1, others, b)
+        col = itab[k, 9]
+        if itab[k, 8] == 0:
+            for m in range(3):
+                out[col + m] = a[m] + (b[m] - a[m]) * u
+        else:
+            d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
+            s = -1.0 if d < 0 else 1.0
+            n = 0.0
+            for m in range(4):
+                a[m] = a[m] + (s * b[m] - a[m]) * u
+                n += a[m] * a[m]
+            n = np.sqrt(n)
+            for m in range(4):
+                out[col + m] = a[m] / n
+
+
+@numba.njit(cache=True)
+def pose_at(t, itab, ftab, key_times, words, base, out):
+    """One pose at clip time ``t`` into ``out`` (J * 10,) float64 (``base``: the rest with the
+    constant tracks)."""
+    out[:] = base
+    a = np.empty(4)
+    b = np.empty(4)
+    _pose(t, itab, ftab, key_times, words, _OTHERS, out, a, b)
+
+
+@numba.njit(cache=True)
+def poses_at(times, itab, ftab, key_times, words, base, out):
+    """Poses at clip times (N,) into ``out`` (N, J * 10) float64."""
+    a = np.empty(4)
+    b = np.empty(4)
+    for n in range(times.shape[0]):
+        out[n, :] = base
+        _pose(times[n], itab, ftab, key_times, words, _OTHERS, out[n], a, b)

@@ -1,0 +1,51 @@
+"""The decoder: compiled and numpy paths agree, bit streams round-trip, bad blobs are refused."""
+import numpy as np
+import pytest
+
+from rigedit.compression import compress_clips
+from rigedit.compression.bits import pack, read_fields, words_of
+from rigedit.compression.codec import kernels
+from rigedit.compression.layout import LayoutError, read_clip
+
+from compression_characters import chain, mocap_clip
+
+
+def test_bit_fields_round_trip():
+    rng = np.random.default_rng(3)
+    widths = rng.integers(0, 33, 3000)
+    values = np.array([rng.integers(0, 2 ** int(w)) if w else 0 for w in widths], np.uint64)
+    start = np.concatenate([[0], np.cumsum(widths)[:-1]])
+    stream = pack(values, widths)
+    assert len(stream) == 4 * ((widths.sum() + 31) // 32)
+    assert np.array_equal(read_fields(words_of(stream), start, widths), values)
+
+
+@pytest.fixture(scope="module")
+def packed():
+    sk = chain(20, 0.05)
+    clip = mocap_clip(sk, frames=200, loop=True)
+    return compress_clips(sk, {"take": clip}, max_error=2e-4).clips["take"]
+
+
+def test_compiled_decoder_matches_numpy(packed):
+    if kernels() is None:
+        pytest.skip("numba is not installed or RIGEDIT_NO_NUMBA is set")
+    times = np.linspace(-0.5, 2 * packed.duration, 301)   # wrapped: a looping clip
+    packed.use_kernels(False)
+    slow = packed.sample_many(times)
+    one = [packed.sample(t).as_array() for t in times[:20]]
+    assert packed.use_kernels(True)
+    fast = packed.sample_many(times)
+    assert np.allclose(fast, slow, atol=1e-12)
+    assert np.allclose([packed.sample(t).as_array() for t in times[:20]], one, atol=1e-12)
+
+
+@pytest.mark.parametrize("cut", [1, 5, 17, 40])
+def test_truncated_blob_is_one_layout_error(packed, cut):
+    with pytest.raises(LayoutError):
+        read_clip(packed.blob[:-cut], len(packed.skeleton))
+
+
+def test_joint_beyond_the_skeleton_is_refused(packed):
+    with pytest.raises(LayoutError, match="joint index"):
+        read_clip(packed.blob, 3)
