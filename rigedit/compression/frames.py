@@ -111,7 +111,7 @@ def sample_track_many(track, times):
         value = track.sample(float(kt[0]))
         return np.repeat(value[None], len(times), axis=0)
     mode = track.interpolation
-    if mode in ("catmull_rom", "cubic_spline"):
+    if mode in ("catmull_rom", "cubic_spline", "bezier"):   # bezier: curves between keys
         return np.array([track.sample(float(t)) for t in times])
     i = np.clip(np.searchsorted(kt, times, side="right") - 1, 0, len(kt) - 2)
     a, b = kv[i], kv[i + 1]
