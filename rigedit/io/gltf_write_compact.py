@@ -36,7 +36,8 @@ import numpy as np
 
 from ..errors import RigFileError
 
-__all__ = ["CompactAnimations", "save_gltf_compressed", "meshopt_available", "MESHOPT"]
+__all__ = ["CompactAnimations", "save_gltf_compressed", "meshopt_available", "decoded_rows",
+           "MESHOPT"]
 
 MESHOPT = "EXT_meshopt_compression"
 _FLOAT, _SHORT = 5126, 5122
@@ -79,6 +80,24 @@ def _outputs(track, kind):
         -1, track.values.shape[1])
 
 
+def _shorts(channel, rows):
+    """(N, 4) int16 of rotation output rows when they fit normalised SHORT, else None."""
+    if channel != "rotation" or np.abs(rows).max() > 1.0:
+        return None
+    return np.clip(np.round(rows * _SHORT_SCALE), -32767, 32767).astype("<i2")
+
+
+def decoded_rows(track):
+    """``(glTF interpolation, (N, C) output rows as a reader decodes them)`` of what the writer
+    stores for ``track`` (normalised SHORT rotations, float32 otherwise)."""
+    kind = _kind(track)
+    rows = _outputs(track, kind)
+    ints = _shorts(track.channel, rows)
+    if ints is not None:
+        return kind, np.maximum(ints / _SHORT_SCALE, -1.0)
+    return kind, rows.astype(np.float32).astype(np.float64)
+
+
 def _is_rest(track, rest):
     """Whether a one-key track holds the node's rest value (a rotation up to its sign)."""
     if len(track.times) != 1:
@@ -107,6 +126,9 @@ class CompactAnimations:
         self.clips = dict(clips)
         self.meshopt = bool(meshopt)
         self._times = {}        # float32 key-time bytes -> accessor index
+        self._clip = None       # the clip being written
+        self._views = []        # (buffer view, clip name, kind) of the animation data
+        self._doc = None
 
     # ------------------------------------------------------------------ accessors
     def _input(self, w, times):
@@ -115,17 +137,33 @@ class CompactAnimations:
         t32 = _float32_times(times)
         key = t32.tobytes()
         if key not in self._times:
-            self._times[key] = w.accessor(t32[:, None], minmax=True)
+            self._times[key] = self._note(w, w.accessor(t32[:, None], minmax=True), "times")
         return self._times[key]
 
-    @staticmethod
-    def _output(w, channel, rows):
-        if channel == "rotation" and np.abs(rows).max() <= 1.0:
-            ints = np.clip(np.round(rows * _SHORT_SCALE), -32767, 32767).astype("<i2")
+    def _note(self, w, accessor, kind):
+        """Remember the accessor's view as animation data of the current clip."""
+        self._views.append((w.doc["accessors"][accessor]["bufferView"], self._clip, kind))
+        return accessor
+
+    def _output(self, w, channel, rows):
+        ints = _shorts(channel, rows)
+        if ints is not None:
             acc = {"bufferView": w.view(ints.tobytes()), "componentType": _SHORT,
                    "normalized": True, "count": len(ints), "type": "VEC4"}
-            return w.add("accessors", acc)
-        return w.accessor(rows)
+            return self._note(w, w.add("accessors", acc), channel)
+        return self._note(w, w.accessor(rows), channel)
+
+    def bytes_by_clip(self):
+        """``{clip name: {kind: bytes}}`` of the animation data written (after :meth:`finish`:
+        the bytes as stored, meshopt-compressed where it is); a time accessor shared by
+        several clips counts in the first."""
+        out = {name: dict.fromkeys(("rotation", "translation", "scale", "times"), 0)
+               for name in self.clips}
+        for view, clip, kind in self._views:
+            v = self._doc["bufferViews"][view]
+            ext = v.get("extensions", {}).get(MESHOPT)
+            out[clip][kind] += ext["byteLength"] if ext else v["byteLength"]
+        return out
 
     # ------------------------------------------------------------------ animations
     def _sampler(self, w, track, end):
@@ -141,7 +179,9 @@ class CompactAnimations:
         from .gltf_write import clip_animation
 
         sk = rig.skeleton
+        self._doc = w.doc
         for name, clip in self.clips.items():
+            self._clip = name
             drop = {id(tr) for (joint, channel), tr in clip.tracks.items()
                     if _is_rest(tr, getattr(sk, f"rest_{channel}")[sk.joint_index(joint)])}
             kept = [tr for tr in clip.tracks.values() if id(tr) not in drop]
@@ -247,6 +287,11 @@ def save_gltf_compressed(rig, path, clips, meshopt=False):
     meshopt : bool
         Also compress the buffers with ``EXT_meshopt_compression`` (required by the file).
 
+    Returns
+    -------
+    CompactAnimations
+        What was written (:meth:`CompactAnimations.bytes_by_clip`).
+
     Raises
     ------
     RigFileError
@@ -258,4 +303,5 @@ def save_gltf_compressed(rig, path, clips, meshopt=False):
         compact = CompactAnimations(clips, meshopt=meshopt)
     except ValueError as exc:
         raise RigFileError(Path(path), str(exc)) from None
-    return save_gltf(rig, path, compact=compact)
+    save_gltf(rig, path, compact=compact)
+    return compact
