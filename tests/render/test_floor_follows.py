@@ -116,3 +116,21 @@ def test_reach_grows_to_the_travel_with_the_same_cells():
         assert floor.cells == 1000        # bounded: MAX_CELLS
     finally:
         plotter.close()
+
+
+def test_a_z_up_floor_follows_in_its_own_plane():
+    plotter = pv.Plotter(off_screen=True)
+    try:
+        floor = Floor(plotter, np.array([-0.5, -0.5, 0.0]), np.array([0.5, 0.5, 2.0]), 2,
+                      (0, 0, 1))
+        height = floor.center[2]
+        assert not floor.follow([1.0, -2.0, 5.0])       # inside the middle half
+        assert floor.follow([100.3, -47.6, 5.0])
+        assert floor.center[2] == height                 # never up or down
+        assert floor.covers(np.array([[100.3, -47.6, 0.0]]), margin=0.4 * floor.size)
+        np.testing.assert_allclose(floor.center[:2] / floor.cell,
+                                   np.round(floor.center[:2] / floor.cell), atol=1e-9)
+        z = floor.plane.points[:, 2]
+        np.testing.assert_allclose(z, height)             # the plane lies flat in X-Y
+    finally:
+        plotter.close()
