@@ -36,7 +36,7 @@ from .bits import MAX_FIELD_BITS, pack
 from .quantise import PER_KEY, VectorCode
 
 __all__ = ["CHANNEL_CODES", "EncodedTrack", "ClipLayout", "write_clip", "read_clip",
-           "LayoutError"]
+           "LayoutError", "ByteReader", "varint"]
 
 CHANNEL_CODES = {"translation": 0, "rotation": 1, "scale": 2}
 CHANNEL_NAMES = {v: k for k, v in CHANNEL_CODES.items()}
@@ -83,7 +83,8 @@ def grid_times(count, uniform, times=None):
     return np.asarray(times, dtype=np.float32).astype(np.float64)
 
 
-def _varint(n):
+def varint(n):
+    """``n`` >= 0 as LEB128 bytes."""
     n = int(n)
     out = bytearray()
     while True:
@@ -100,18 +101,18 @@ def write_clip(layout):
     """The blob of a :class:`ClipLayout`, bytes."""
     out = bytearray()
     name = layout.name.encode("utf-8")
-    out += _varint(len(name)) + name
+    out += varint(len(name)) + name
     out += struct.pack("<dB", layout.duration, int(layout.loop) | (2 if layout.uniform else 0))
-    out += _varint(len(layout.times))
+    out += varint(len(layout.times))
     if layout.uniform:
         out += struct.pack("<dd", *layout.uniform)
     else:
         out += np.asarray(layout.times, dtype="<f4").tobytes()
-    out += _varint(len(layout.constant))
+    out += varint(len(layout.constant))
     for tr in layout.constant:
-        out += _varint(tr.joint) + bytes([CHANNEL_CODES[tr.channel]])
+        out += varint(tr.joint) + bytes([CHANNEL_CODES[tr.channel]])
         out += np.asarray(tr.value, dtype="<f4").tobytes()
-    out += _varint(len(layout.animated))
+    out += varint(len(layout.animated))
     fields, widths = [], []
     count = len(layout.times)
     for tr in layout.animated:
@@ -119,8 +120,8 @@ def write_clip(layout):
         steps = np.diff(keys)
         every = len(keys) == count
         dbits = 0 if every else max(int(steps.max()).bit_length(), 1)
-        out += _varint(tr.joint) + bytes([CHANNEL_CODES[tr.channel] | (tr.mode << 2)])
-        out += _varint(len(keys)) + bytes([dbits])
+        out += varint(tr.joint) + bytes([CHANNEL_CODES[tr.channel] | (tr.mode << 2)])
+        out += varint(len(keys)) + bytes([dbits])
         if tr.mode == PER_KEY:
             out += bytes([int(tr.code.bits[0])])
         else:
@@ -142,11 +143,11 @@ def write_clip(layout):
         widths.append(np.tile(w, k))
     stream = pack(np.concatenate(fields) if fields else np.zeros(0),
                   np.concatenate(widths) if widths else np.zeros(0))
-    out += _varint(len(stream) // 4) + stream
+    out += varint(len(stream) // 4) + stream
     return bytes(out)
 
 
-class _Reader:
+class ByteReader:
     """Reads a blob front to back; every read checked against its end."""
 
     def __init__(self, blob):
@@ -200,7 +201,7 @@ def read_clip(blob, num_joints):
         Truncated data, a count beyond what the blob can hold, a joint index beyond
         ``num_joints``, unknown codes, key steps that do not fit the frames.
     """
-    r = _Reader(blob)
+    r = ByteReader(blob)
     size = len(blob)
     name = bytes(r.take(r.varint("clip name length", size), "clip name")).decode(
         "utf-8", errors="replace")

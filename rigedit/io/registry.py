@@ -12,6 +12,8 @@ of clip names. A new format is one reader, one writer and one line of :data:`FOR
 ``fbx``     ``.fbx``              :mod:`rigedit.io.fbx_read` (through ufbx, in a child
                                   process: :mod:`rigedit.io.fbx_isolated`),
                                   :mod:`rigedit.io.fbx_write` (binary FBX 7.4)
+``rgc``     ``.rgc``              :mod:`rigedit.io.compressed_file`: a skeleton and
+                                  compressed clips, no mesh
 ==========  ====================  =================================================
 """
 from __future__ import annotations
@@ -23,6 +25,7 @@ from typing import Callable, Tuple
 from ..errors import RigFileError
 from .bvh import read_bvh
 from .bvh_write import write_bvh
+from .compressed_file import read_compressed, write_compressed
 from .fbx_isolated import read_fbx  # fbx_read's reader, in a child process (see there)
 from .fbx_write import write_fbx
 from .gltf_read import read_gltf
@@ -50,6 +53,7 @@ FORMATS = (
     Format("gltf", (".glb", ".gltf"), read_gltf, save_gltf, options=("allow_outside_uris",)),
     Format("bvh", (".bvh",), read_bvh, write_bvh, options=("scale",)),
     Format("fbx", (".fbx",), read_fbx, write_fbx),
+    Format("rgc", (".rgc",), read_compressed, write_compressed),
 )
 
 #: File suffixes that hold a whole rig (besides folders and bundled names).

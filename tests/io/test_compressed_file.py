@@ -1,0 +1,89 @@
+"""rigedit's .rgc file: round trip through load_rig / save_rig, and every truncation or
+altered byte is one RigFileError naming the file."""
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rigedit
+from rigedit.compression import CompressedClip, compress_clips
+from rigedit.errors import RigFileError
+from rigedit.io.compressed_file import read_clip_file, save_compressed
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "compression"))
+from compression_characters import chain, mocap_clip  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    sk = chain(8, 0.1)
+    clips = {"a": mocap_clip(sk, 60, name="a"), "b": mocap_clip(sk, 30, seed=4, name="b",
+                                                                loop=True)}
+    result = compress_clips(sk, clips, max_error=1e-4)
+    path = tmp_path_factory.mktemp("rgc") / "clips.rgc"
+    save_compressed(path, sk, result.clips)
+    return path, sk, clips, result
+
+
+def test_round_trip_through_load_rig(written):
+    path, sk, clips, result = written
+    rig = rigedit.load_rig(path)
+    assert rig.skeleton.names == sk.names
+    assert np.allclose(rig.skeleton.rest_translation, sk.rest_translation)
+    assert set(rig.clips) == {"a", "b"} and rig.clips["b"].loop
+    for name, clip in rig.clips.items():
+        assert isinstance(clip, CompressedClip)
+        assert clip.blob == result.clips[name].blob
+        times = np.linspace(0, clip.duration, 17)
+        assert np.allclose(clip.sample_many(times), result.clips[name].sample_many(times))
+    assert "compressed" in rig.meta.notes
+
+
+def test_save_rig_compresses_plain_clips(tmp_path):
+    sk = chain(4, 0.1)
+    rig = rigedit.Rig(sk, np.zeros((0, 3)), np.zeros((0, 3), dtype=int),
+                      np.zeros((0, 1), dtype=int), np.zeros((0, 1)),
+                      clips={"take": mocap_clip(sk, 40)})
+    rigedit.save_rig(rig, tmp_path / "x.rgc")
+    back = rigedit.load_rig(tmp_path / "x.rgc")
+    from rigedit.compression import measure_error
+    assert measure_error(sk, rig.clips["take"], back.clips["take"]).max() <= 1e-4
+
+
+def test_every_truncation_is_one_error(written, tmp_path):
+    path, *_ = written
+    blob = path.read_bytes()
+    bad = tmp_path / "cut.rgc"
+    for cut in list(range(0, 40)) + list(range(40, len(blob), max(len(blob) // 60, 1))):
+        bad.write_bytes(blob[:cut])
+        with pytest.raises(RigFileError) as info:
+            read_clip_file(bad)
+        assert str(bad) in str(info.value) and "\n" not in str(info.value)
+
+
+def test_altered_bytes_fail_the_checksum(written, tmp_path):
+    path, *_ = written
+    blob = bytearray(path.read_bytes())
+    bad = tmp_path / "flip.rgc"
+    rng = np.random.default_rng(0)
+    for at in rng.integers(12, len(blob), 40):
+        copy = bytearray(blob)
+        copy[at] ^= 0x5A
+        bad.write_bytes(bytes(copy))
+        with pytest.raises(RigFileError, match=str(bad)):
+            read_clip_file(bad)
+
+
+def test_huge_claims_are_refused_before_allocating(tmp_path):
+    import struct
+    bad = tmp_path / "claim.rgc"
+    bad.write_bytes(b"RGC1" + struct.pack("<HHI", 1, 0, 2 ** 31) + b"\0" * 20)
+    with pytest.raises(RigFileError, match="sections claimed"):
+        read_clip_file(bad)
+    bad.write_bytes(b"RGC1" + struct.pack("<HHI", 1, 0, 1) + b"SKEL" + struct.pack("<II", 2**31, 0))
+    with pytest.raises(RigFileError, match="truncated"):
+        read_clip_file(bad)
+    bad.write_bytes(b"not a clip file at all")
+    with pytest.raises(RigFileError, match="magic"):
+        rigedit.load_rig(bad)
