@@ -19,7 +19,7 @@ def test_kind_by_suffix_and_folder(tmp_path):
 def test_unknown_file_kind_names_file_and_kinds(tmp_path):
     path = tmp_path / "model.3ds"
     path.write_text("x")
-    with pytest.raises(RigFileError, match=r"model\.3ds.*\.glb, \.gltf, \.bvh or \.fbx"):
+    with pytest.raises(RigFileError, match=r"model\.3ds.*\.glb, \.gltf, \.bvh, \.fbx or \.rgc"):
         rigedit.load_rig(path)
 
 
