@@ -127,11 +127,20 @@ def unwrap(angles, order=DEFAULT_ORDER, reference=None):
     """
     axes = _check(order)
     seq, alt = _triples(angles, axes)
-    out = np.empty_like(seq)
-    prev = None if reference is None else np.asarray(reference, dtype=float)[axes]
-    for i in range(len(seq)):   # sequential: each key depends on the one before
-        out[i] = seq[i] if prev is None else _pick(seq[i], alt[i], prev)
-        prev = out[i]
+    prev = None if reference is None else [float(x) for x in np.asarray(reference)[axes]]
+    rows = []
+    # sequential (each key depends on the one before), so on Python floats: numpy's per-call
+    # overhead would make it ~30 times slower per key
+    for a, b in zip(seq.tolist(), alt.tolist()):
+        if prev is not None:
+            a = [x + 360.0 * round((p - x) / 360.0) for x, p in zip(a, prev)]
+            b = [x + 360.0 * round((p - x) / 360.0) for x, p in zip(b, prev)]
+            if sum((x - p) ** 2 for x, p in zip(b, prev)) < \
+                    sum((x - p) ** 2 for x, p in zip(a, prev)):
+                a = b
+        rows.append(a)
+        prev = a
+    out = np.array(rows, dtype=np.float64).reshape(-1, 3)
     res = np.empty_like(out)
     res[:, axes] = out
     return res
