@@ -15,7 +15,7 @@ __all__ = ["QUANTISE_SHARE", "encode_track", "gltf_track"]
 #: measures the quantised values, so the two together stay within the tolerance). One bit
 #: more per component halves the quantisation error; the share was picked by measurement
 #: (docs/compression.md).
-QUANTISE_SHARE = 0.4
+QUANTISE_SHARE = 0.8
 
 
 def _classified(values, rest, tol, rotation):
