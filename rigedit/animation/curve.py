@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["INTERPOLATIONS", "HANDLE_TYPES", "EASINGS", "AUTO_TYPES", "Curve",
+__all__ = ["INTERPOLATIONS", "HANDLE_TYPES", "EASINGS", "AUTO_TYPES", "KEY_TOLERANCE", "Curve",
            "bezier_points", "solve_u", "ONE_KEY_HANDLE"]
 
 INTERPOLATIONS = ("constant", "linear", "bezier")
@@ -39,6 +39,8 @@ EASINGS = ("ease_in", "ease_out", "ease_in_out")
 AUTO_TYPES = ("auto", "auto_clamped", "vector")
 #: Time length (seconds) of the handles of a key without neighbours.
 ONE_KEY_HANDLE = 1.0 / 3.0
+#: Two key times closer than this (seconds) are the same key (tracks use the same).
+KEY_TOLERANCE = 1e-6
 #: Easing presets make the eased handle this fraction of its segment long (flat).
 EASE_LENGTH = 0.6
 
@@ -261,12 +263,13 @@ class Curve:
                 pts[other][i] = key + d / n * length
         return self._replace(left=pts["left"], right=pts["right"], left_type=lt, right_type=rt)
 
-    def with_key(self, t, value=None):
+    def with_key(self, t, value=None, tol=KEY_TOLERANCE):
         """A key inserted at ``t`` (``value``: the curve's value there when None; a key already
-        within 1e-9 s of ``t`` takes the value instead). New keys are bezier, auto_clamped."""
+        within ``tol`` seconds of ``t`` takes the value instead). New keys are bezier,
+        auto_clamped."""
         t = float(t)
         v = self.sample(t) if value is None else float(value)
-        near = np.flatnonzero(np.abs(self.times - t) <= 1e-9)
+        near = np.flatnonzero(np.abs(self.times - t) <= tol)
         if len(near):
             return self.with_keys_moved(near, 0.0, v - self.values[near[0]])
         j = int(np.searchsorted(self.times, t))

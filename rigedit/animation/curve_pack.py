@@ -6,8 +6,8 @@ a loaded machine), so a 60-joint pose of bezier tracks would take tens of millis
 segment with one ``searchsorted`` (each curve's keys shifted into its own time window) and
 evaluates all segments together (:func:`~rigedit.animation.curve.evaluate`). A
 :class:`BezierTracks` packs a clip's bezier tracks and converts their rotations from Euler
-angles in one call per Euler order, writing each pose field with one indexed assignment. :class:`~rigedit.animation.clip.Clip` keeps one,
-rebuilt when its ``revision`` changes.
+angles in one call per Euler order, writing each pose field with one indexed assignment.
+:class:`~rigedit.animation.clip.Clip` keeps one, rebuilt when its ``revision`` changes.
 """
 from __future__ import annotations
 

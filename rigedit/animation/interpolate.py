@@ -49,8 +49,8 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["MODES", "VECTOR_MODES", "ROTATION_MODES", "HYBRID_THRESHOLD", "segment",
-           "sample_track", "sample_many", "lerp", "nlerp", "slerp", "hybrid", "catmull_rom_tangents",
-           "hermite"]
+           "sample_track", "sample_many", "lerp", "nlerp", "slerp", "hybrid",
+           "catmull_rom_tangents", "hermite"]
 
 VECTOR_MODES = ("step", "linear", "catmull_rom", "cubic_spline")
 ROTATION_MODES = ("step", "nlerp", "slerp", "hybrid", "catmull_rom", "cubic_spline")

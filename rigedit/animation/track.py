@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .curve import Curve
+from .curve import KEY_TOLERANCE, Curve
 from .curve_track import curves_from_track, remove_times, retime
 from .euler_curves import DEFAULT_ORDER, EULER_ORDERS, euler_to_quat, quat_to_euler
 from .interpolate import (ROTATION_MODES, VECTOR_MODES, catmull_rom_tangents, sample_many,
@@ -14,8 +14,6 @@ __all__ = ["CHANNELS", "DEFAULT_MODE", "KEY_TOLERANCE", "Track", "curves_from_tr
 #: Channel name -> value width.
 CHANNELS = {"translation": 3, "rotation": 4, "scale": 3}
 DEFAULT_MODE = {"translation": "linear", "rotation": "slerp", "scale": "linear"}
-#: Two key times closer than this (seconds) are the same key.
-KEY_TOLERANCE = 1e-6
 
 
 class Track:

@@ -88,3 +88,23 @@ def test_a_track_without_three_curves_or_with_a_bad_order(tmp_path, clip):
         path.write_text(json.dumps(data))
         with pytest.raises(RigFileError, match=message):
             load_clip(path, clip.skeleton)
+
+
+def test_a_rig_folder_keeps_bezier_tracks(tmp_path):
+    import rigedit
+    from builders import cylinder_rig
+    from rigedit.io.rig_save import save_rig_folder_atomic
+    rig = cylinder_rig()
+    clip = rig.clips["bend"]
+    bent = clip.tracks[("j1", "rotation")].with_interpolation("bezier")
+    curves = list(bent.curves)
+    curves[2] = curves[2].with_easing([1], "ease_in_out")
+    clip.set_track("j1", "rotation", Track.from_curves("rotation", curves))
+    save_rig_folder_atomic(tmp_path / "rig", rig)
+    back = rigedit.load_rig(tmp_path / "rig").clips["bend"]
+    got = back.tracks[("j1", "rotation")]
+    assert got.interpolation == "bezier" and list(got.curves[2].left_type) == list(
+        curves[2].left_type)
+    for t in np.linspace(0, 1, 21):
+        a, b = clip.sample(t).rotation, back.sample(t).rotation
+        np.testing.assert_allclose(np.abs(np.sum(a * b, axis=1)), 1, atol=1e-9)
