@@ -83,7 +83,7 @@ class Engine:
             with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
                 self.cluster = distributed.LocalCluster(
                     n_workers=self.workers or os.cpu_count() or 1, threads_per_worker=1,
-                    processes=True, dashboard_address=None, silence_logs=logging.CRITICAL)
+                    processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL)
             self.client = distributed.Client(self.cluster)
         else:
             self._connect(distributed)

@@ -103,7 +103,8 @@ def _autorig(task):
     _thumbnail(task, rig, rig.clips.get("walk") or (_pick_clip(rig, None, task["input"])
                                                    if rig.clips else None))
     o = report.orientation
-    quality = {"orientation": o.describe(), "orientation sure": bool(o.sure),
+    quality = {"sure": bool(report.sure), "orientation": o.describe(),
+               "orientation sure": bool(o.sure),
                "orientations tried": report.orientations[:2],
                "embedding cost": round(float(report.cost), 4),
                "joints placed": len(report.placed), "joints": len(rig.skeleton),

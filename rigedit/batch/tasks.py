@@ -27,7 +27,7 @@ JOBS = {
     "render": {"clip": None, "fps": 24.0, "size": "320x240", "view": "front",
                "duration": None, "video": "mp4"},
     "convert": {"to": None, "clip": None},
-    "compress": {"max_error": None},
+    "compress": {"max_error": None, "shell": 3.0},
     "noop": {},
 }
 #: Options every job takes.
@@ -103,6 +103,7 @@ def check_options(job, options):
         _choice(job, "to", s["to"], tuple(_FORMATS))
     elif job == "compress":
         s["max_error"] = _positive(job, "max_error", s["max_error"], 100)
+        s["shell"] = _positive(job, "shell", s["shell"], 100)
         if s["max_error"] is None:
             raise BatchUsageError("compress: expected --max-error CM")
     return s

@@ -74,6 +74,14 @@ def add_parser(sub):
     j.add_argument("--to", required=True, metavar="glb|bvh|folder")
     j.add_argument("--clip", default=None, metavar="NAME", help="the clip of a .bvh output")
 
+    j = jobs.add_parser("compress", help="every rig's clips compressed with a guaranteed "
+                                         "error into a compact .glb")
+    j.add_argument("inputs", nargs="+", metavar="FILES")
+    j.add_argument("--max-error", type=float, required=True, metavar="CM",
+                   help="largest virtual-vertex error in cm on any frame")
+    j.add_argument("--shell", type=float, default=3.0, metavar="CM",
+                   help="distance of the virtual vertices from each joint in cm (default 3)")
+
     for j in jobs.choices.values():
         _common(j)
     s.set_defaults(func=cmd_batch, folder_output=True)

@@ -116,8 +116,25 @@ def test_outputs_of_inputs_with_one_name_do_not_collide(tmp_path):
     ("retarget", {"to": ["no/such/rig.glb"]}, "no such rig"),
     ("autorig", {"method": "magic"}, "--method"),
     ("autorig", {"colour": "red"}, "unknown option colour"),
+    ("compress", {}, "expected --max-error"),
+    ("compress", {"max_error": -1}, "--max-error"),
     ("dance", {}, "expected a job"),
 ])
 def test_options_that_make_no_sense_are_refused(job, options, message):
     with pytest.raises(BatchUsageError, match=message):
         check_options(job, options)
+
+
+def test_compress_keeps_its_bound_and_reports_ratio_and_error(tmp_path):
+    from batch_helpers import make_motions
+    from rigedit.batch.jobs import run_task
+
+    (motion,) = make_motions(tmp_path / "in", 1)
+    settings = check_options("compress", {"max_error": 0.05, "thumbnails": False})
+    (task,) = plan("compress", [motion], tmp_path, settings)
+    entry = run_task(task)
+    assert entry["status"] == "ok", entry["error"]
+    q = entry["quality"]
+    assert 0 < q["max error (cm)"] <= 0.05 and q["ratio"] > 1
+    assert q["compressed (KB)"] < q["raw (KB)"]
+    assert len(rigedit.load_rig(tmp_path / task["outputs"][0]).clips) == 1
