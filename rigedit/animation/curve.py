@@ -336,12 +336,14 @@ class Curve:
     def scaled(self, indices, time_pivot, time_factor, value_pivot, value_factor):
         """Keys ``indices`` (and their handles) scaled about ``(time_pivot, value_pivot)``.
 
-        A negative or zero time factor would reorder or merge keys: it is refused
-        (``ValueError``); the scaled keys' times are then clamped between the unscaled
-        neighbours as :meth:`with_keys_moved` does.
+        A time factor below :data:`MIN_TIME_FACTOR` (zero or negative: keys would merge or
+        mirror in time, out of order) is raised to it; the scaled keys' times are then
+        clamped between the unscaled neighbours as :meth:`with_keys_moved` does.
         """
-        if not time_factor > 0:
-            raise ValueError(f"curve: expected a time factor > 0, got {time_factor}")
+        if not np.isfinite(time_factor) or not np.isfinite(value_factor):
+            raise ValueError(f"curve: expected finite factors, got {time_factor}, "
+                             f"{value_factor}")
+        time_factor = max(float(time_factor), MIN_TIME_FACTOR)
         idx = np.unique(np.asarray(indices, dtype=int).reshape(-1))
         times, values = self.times.copy(), self.values.copy()
         left, right = self.left.copy(), self.right.copy()
@@ -380,6 +382,8 @@ class Curve:
 
 #: Closest two keys may come (seconds) when a key is moved towards its neighbour.
 MIN_GAP = 1e-4
+#: Smallest time factor of :meth:`Curve.scaled` (keys are not mirrored in time).
+MIN_TIME_FACTOR = 1e-3
 
 
 def _bounds(times, idx):

@@ -154,8 +154,11 @@ def test_scaling_keys_about_a_pivot(curve):
     c = curve.scaled([1, 2], 1.0, 1.5, 0.0, 2.0)
     np.testing.assert_allclose(c.times, [0, 1, 2.5, 3])
     np.testing.assert_allclose(c.values, [0, 2, 1, 2])
+    # keys are not mirrored in time: a factor <= 0 is the smallest one, order kept
+    flat = curve.scaled([1, 2], 1.5, -1.0, 0.0, 1.0)
+    np.testing.assert_allclose(flat.times[1:3], [1.5 - 0.5e-3, 1.5 + 0.5e-3])
     with pytest.raises(ValueError):
-        curve.scaled([1], 0, -1, 0, 1)
+        curve.scaled([1], 0, np.nan, 0, 1)
 
 
 def test_key_near(curve):
