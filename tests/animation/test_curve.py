@@ -174,3 +174,19 @@ def test_bad_curves_are_refused():
         Curve([0, 1], [0, 1], "cubic")
     with pytest.raises(ValueError, match="handle type"):
         Curve([0, 1], [0, 1], left_type="smooth")
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(-2.0, 2.0), min_size=4, max_size=4),
+       st.lists(st.floats(-5.0, 5.0), min_size=4, max_size=4))
+def test_any_free_handles_sample_on_their_bezier(dx, dy):
+    # handles anywhere (even reaching past the other key, or backwards): clamped and scaled
+    # into a function of time, the samples lie on the Bezier of the corrected points
+    c = Curve([0, 1], [0, 1], left=[[dx[0], dy[0]], [1 + dx[1], 1 + dy[1]]],
+              right=[[dx[2], dy[2]], [1 + dx[3], 1 + dy[3]]], left_type="free",
+              right_type="free")
+    seg = c.segments()[0]
+    assert np.all(np.diff(seg[:, 0]) >= -1e-12)   # control times in order: x(u) monotone
+    for u in np.linspace(0, 1, 9):
+        t, v = bezier_at(seg, u)
+        assert c.sample(t) == pytest.approx(v, abs=1e-7)

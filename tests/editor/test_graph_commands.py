@@ -68,11 +68,12 @@ def test_edit_curves_is_one_undo_step_and_tells_the_views(doc):
 
 def test_a_drag_is_one_undo_step_and_cancel_restores(doc):
     base = view(doc, RZ).curve
+    seen = keys_events(doc)
     drag = gc.CurveDrag(doc, "Drag key")
     for dv in (5, 10, 20):
         drag.update({RZ: base.with_keys_moved([1], 0, dv)})
         assert euler_z(doc, 0.5) == pytest.approx(60 + dv, abs=1e-6)
-    assert len(doc.undo_stack) == 0
+    assert len(doc.undo_stack) == 0 and len(seen) == 3   # the views follow the drag live
     assert drag.finish() is True and len(doc.undo_stack) == 1
     assert euler_z(doc, 0.5) == pytest.approx(80, abs=1e-6)
     doc.undo()
@@ -107,10 +108,17 @@ def test_insert_delete_and_per_key_settings(doc):
     assert gc.delete_keys(doc, {RZ: [1]}) == 1 and len(view(doc, RZ).curve) == 3
     n = len(doc.undo_stack)
     assert n == 5
-    for _ in range(n):
+    states = []
+    for _ in range(n):   # each step undoes to a different clip, then redoes to the same
+        states.append([float(euler_z(doc, t)) for t in (0.1, 0.2, 0.3, 0.6)])
         doc.undo()
     assert doc.clip.tracks[("j1", "rotation")].interpolation != "bezier"
     assert ("j1", "translation") not in doc.clip.tracks
+    for state in reversed(states):
+        doc.redo()
+        np.testing.assert_allclose([euler_z(doc, t) for t in (0.1, 0.2, 0.3, 0.6)], state,
+                                   atol=1e-9)
+    assert len(view(doc, RZ).curve) == 3 and view(doc, RZ).curve.left_type[2] == "free"
 
 
 def test_deleting_every_key_of_a_channel_removes_its_track(doc):
