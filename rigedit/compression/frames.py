@@ -3,9 +3,11 @@
 "Every frame" of a clip (the times the guarantee holds on) is the union of
 
 - the clip's own key times (a mocap clip: its frames), and
-- a sampling at the clip's frame rate over ``[0, duration]``: the rate is the one its key
-  spacing shows (the median spacing of all key times, rounded to a whole number of frames per
-  second when within 1%), 30 Hz when the clip has fewer than two distinct key times.
+- a sampling at the clip's frame rate over ``[0, duration]``. A clip whose median key spacing
+  is under 1/20 s is keyed at every frame: its rate is 1 / that spacing (rounded to a whole
+  number of frames per second when within 1%). A sparser clip's rate is the first of 30, 24,
+  25, 60, 50 and 120 Hz on whose frames all its keys fall (within 1% of a frame), else 30 Hz;
+  30 Hz too for a clip with fewer than two distinct key times.
 
 A clip keyed at 120 Hz is checked at its 120 Hz frames; a clip keyed sparsely at 30 fps frame
 numbers is checked at every 30 Hz frame between its keys, not only at the keys.
@@ -21,8 +23,13 @@ from ..model.pose import Pose
 __all__ = ["FALLBACK_RATE", "COLUMNS", "frame_rate", "frame_times", "local_times", "sample_local",
            "sample_track_many"]
 
-#: Frames per second of a clip whose keys show none (fewer than two distinct key times).
+#: Frames per second of a clip whose keys show none (fewer than two distinct key times, or
+#: sparse keys on no rate of :data:`SPARSE_RATES`).
 FALLBACK_RATE = 30.0
+#: Keys closer than 1 / DENSE_RATE seconds (median) are a clip keyed at every frame.
+DENSE_RATE = 20.0
+#: The frame rates a sparsely keyed clip may be authored at, in the order they are tried.
+SPARSE_RATES = (30, 24, 25, 60, 50, 120)
 #: At most this many frames are checked per clip (a bound on memory: 10 floats per joint per
 #: frame); a longer clip at its rate is an error rather than an allocation the size it claims.
 MAX_FRAMES = 2_000_000
@@ -31,15 +38,21 @@ COLUMNS = {"translation": slice(0, 3), "rotation": slice(3, 7), "scale": slice(7
 
 
 def frame_rate(clip):
-    """Frames per second the clip's key spacing shows (see the module notes), float."""
+    """Frames per second the clip's keys show (see the module notes), float."""
     times = clip.key_times()
     steps = np.diff(times)
     steps = steps[steps > KEY_TOLERANCE]
     if len(steps) == 0:
         return FALLBACK_RATE
     rate = 1.0 / float(np.median(steps))
-    whole = round(rate)
-    return float(whole) if whole >= 1 and abs(rate - whole) <= 0.01 * whole else rate
+    if rate >= DENSE_RATE:       # keyed every frame (mocap, a baked clip): its own rate
+        whole = round(rate)
+        return float(whole) if abs(rate - whole) <= 0.01 * whole else rate
+    for rate in SPARSE_RATES:    # keyed on some frames: the first rate they all fall on
+        frames = times * rate
+        if np.all(np.abs(frames - np.round(frames)) <= 0.01):
+            return float(rate)
+    return FALLBACK_RATE
 
 
 def frame_times(clip, rate=None):
