@@ -127,6 +127,26 @@ def unwrap(angles, order=DEFAULT_ORDER, reference=None):
     """
     axes = _check(order)
     seq, alt = _triples(angles, axes)
+    base = seq.copy()
+    if reference is not None and len(seq):
+        ref = np.asarray(reference, dtype=float)[axes]
+        first = _pick(seq[0], alt[0], ref)
+        if not np.array_equal(first, _nearest_turn(seq[0], ref)):
+            base = alt.copy()      # the first key is on the other branch: stay on it
+        base[0] = first
+    # fast path: whole turns per axis on one branch (np.unwrap). When no step between rows
+    # is 90 degrees or more, the other branch (180 away on two angles) is never nearer, so
+    # this is what the key-by-key choice gives; else (through gimbal lock) key by key.
+    fast = np.unwrap(base, period=360.0, axis=0)
+    if len(fast) < 2 or np.max(np.abs(np.diff(fast, axis=0))) < 90.0:
+        res = np.empty_like(fast)
+        res[:, axes] = fast
+        return res
+    return _unwrap_sequential(seq, alt, axes, reference)
+
+
+def _unwrap_sequential(seq, alt, axes, reference):
+    """:func:`unwrap` key by key: each row the triple nearest the row before."""
     prev = None if reference is None else [float(x) for x in np.asarray(reference)[axes]]
     rows = []
     # sequential (each key depends on the one before), so on Python floats: numpy's per-call

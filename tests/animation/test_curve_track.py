@@ -142,3 +142,17 @@ def test_sample_many_equals_sample_per_time(channel, mode):
         np.testing.assert_allclose(np.abs(np.sum(many * one, axis=1)), 1, atol=1e-12)
     else:
         np.testing.assert_allclose(many, one, atol=1e-12)
+
+
+@pytest.mark.parametrize("order", ["XYZ", "ZXY"])
+def test_unwrap_fast_path_equals_key_by_key(order):
+    from rigedit.animation.euler_curves import _triples, _unwrap_sequential, principal, unwrap
+    rng = np.random.default_rng(7)
+    axes = ["XYZ".index(a) for a in order]
+    for scale in (5.0, 40.0):   # smooth, and wild enough to pass through gimbal lock
+        angles = np.cumsum(rng.uniform(-scale, scale, (300, 3)), axis=0)
+        p = principal(euler_to_quat(angles, order), order)
+        ref = angles[0] + 720.0
+        seq, alt = _triples(p, axes)
+        np.testing.assert_allclose(unwrap(p, order, ref),
+                                   _unwrap_sequential(seq, alt, axes, ref), atol=1e-9)
