@@ -33,6 +33,8 @@ from . import errors_hook
 from .autorig_dialog import AutorigAction
 from .autosave import Autosave, confirm_unsaved_changes
 from .brush_panel import BrushPanel
+from .compare_view import CompareCompressed
+from .compress_dialog import CompressionSettings, ExportCompressed
 from .edit_actions import EditActions
 from .fallback import default_rig
 from .file_actions import FileActions
@@ -94,6 +96,8 @@ class MainWindow(QtWidgets.QMainWindow):
         ``joint_panel`` and ``info_panel`` in their docks.
     timeline : TimelineDock
     files, autorig, reembed, motion_import, recorder, weight_tools : the File menu's parts
+    export_compressed, compare : File > Export compressed, View > Compare compressed
+        (:mod:`.compress_dialog`, :mod:`.compare_view`), sharing ``compression`` (the bound)
     weight_brush : WeightBrush
     rebind : RestRebind
         Edit-mode rest moves re-bound in a worker; Undo cancelling a running one.
@@ -144,8 +148,11 @@ class MainWindow(QtWidgets.QMainWindow):
         self.reembed = ReembedAction(d, services)
         self.motion_import = ImportMotion(d, services, self.timeline.clip_manager.add_clip)
         self.recorder = RecordVideo(d, view, services)
+        self.compression = CompressionSettings()   # the export's and the comparison's
+        self.export_compressed = ExportCompressed(d, services, self.compression)
         d.listen(self._on_event)   # after the timeline (it samples the clip first)
         self._on_event(ev.RigReplaced())
+        self.compare = CompareCompressed(d, view, services, self.compression)   # after the view
         # parts that draw into (or listen to) the scene come once it is built
         self.weight_brush = WeightBrush(d, view, BrushPanel(), self.panels.info_panel,
                                         services, self.set_weights_view)
@@ -175,8 +182,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def _build_menus(self):
         parts = (self.files, self.autorig, self.reembed, self.motion_import, self.recorder,
-                 self.edit, self.view_actions, self.panels, self.weight_brush,
-                 self.weight_tools, self.morph_dock)
+                 self.export_compressed, self.compare, self.edit, self.view_actions,
+                 self.panels, self.weight_brush, self.weight_tools, self.morph_dock)
         actions = {"timeline_dock": self.timeline.toggleViewAction()}
         for part in parts:
             actions.update(part.actions())
