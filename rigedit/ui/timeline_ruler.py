@@ -9,6 +9,7 @@ import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
 from ..editor.playback import snap_to_frame
+from .cached_paint import cached_picture
 
 __all__ = ["TimelineRuler"]
 
@@ -94,12 +95,7 @@ class TimelineRuler(QtWidgets.QWidget):
 
     # ------------------------------------------------------------------ painting
     def paintEvent(self, _event):
-        ratio = self.devicePixelRatioF()
-        if self._background is None or self._background.devicePixelRatioF() != ratio:
-            self._background = QtGui.QPixmap(self.size() * ratio)
-            self._background.setDevicePixelRatio(ratio)
-            self._background.fill(QtCore.Qt.transparent)
-            self._paint_background(self._background)
+        self._background = cached_picture(self, self._background, self._paint_background)
         p = QtGui.QPainter(self)
         p.drawPixmap(0, 0, self._background)  # clipped to the repainted region
         p.setRenderHint(QtGui.QPainter.Antialiasing)
