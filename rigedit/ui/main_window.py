@@ -11,7 +11,7 @@ part               module
 view options       :mod:`.view_actions` (View menu, tool bar, pose / edit mode)
 Edit menu          :mod:`.edit_actions` (undo, redo, reset, mirror)
 docks              :mod:`.panels` (joints, info), :mod:`.timeline` (playback, keys, clips),
-                   :mod:`.morph_panel` (shapes)
+                   :mod:`.morph_panel` (shapes), :mod:`.graph_editor` (curves)
 File menu          :mod:`.file_actions`, :mod:`.autorig_dialog`, :mod:`.reembed`,
                    :mod:`.import_motion`, :mod:`.record_dialog`, :mod:`.weight_tools`
 jobs               :mod:`.jobs` (progress bar, Cancel), :mod:`.rebind` (edit-mode re-binds)
@@ -38,6 +38,7 @@ from .compress_dialog import CompressionSettings, ExportCompressed
 from .edit_actions import EditActions
 from .fallback import default_rig
 from .file_actions import FileActions
+from .graph_editor import GraphEditor
 from .import_motion import ImportMotion
 from .jobs import JobRunner
 from .menus import build_menus
@@ -95,6 +96,8 @@ class MainWindow(QtWidgets.QMainWindow):
     panels : Panels
         ``joint_panel`` and ``info_panel`` in their docks.
     timeline : TimelineDock
+    graph_editor : GraphEditor
+        The graph editor dock (``graph_editor.dock``, hidden until View > Graph editor).
     files, autorig, reembed, motion_import, recorder, weight_tools : the File menu's parts
     export_compressed, compare : File > Export compressed, View > Compare compressed
         (:mod:`.compress_dialog`, :mod:`.compare_view`), sharing ``compression`` (the bound)
@@ -179,11 +182,13 @@ class MainWindow(QtWidgets.QMainWindow):
         self.timeline = TimelineDock(self.document, services, self)
         self.addDockWidget(QtCore.Qt.BottomDockWidgetArea, self.timeline)
         self.morph_dock = MorphDock(self, self.document, self.status)   # right, under Info
+        self.graph_editor = GraphEditor(self, self.document, self.timeline, self.status)
 
     def _build_menus(self):
         parts = (self.files, self.autorig, self.reembed, self.motion_import, self.recorder,
                  self.export_compressed, self.compare, self.edit, self.view_actions,
-                 self.panels, self.weight_brush, self.weight_tools, self.morph_dock)
+                 self.panels, self.weight_brush, self.weight_tools, self.morph_dock,
+                 self.graph_editor)
         actions = {"timeline_dock": self.timeline.toggleViewAction()}
         for part in parts:
             actions.update(part.actions())

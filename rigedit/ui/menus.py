@@ -31,7 +31,7 @@ MENUS = (
                ("skeleton", "gizmos", "weights", "weight_brush", "dqs", "floor",
                 "compare_compressed"),
                ("front", "side", "top", "back", "reset_camera"),
-               ("joints_dock", "info_dock", "shapes_dock", "timeline_dock"))),
+               ("joints_dock", "info_dock", "shapes_dock", "timeline_dock", "graph_dock"))),
 )
 
 #: The "Tools" tool bar: action or widget names, :class:`Label` texts, None for a separator.
