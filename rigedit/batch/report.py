@@ -2,9 +2,9 @@
 
 Self-contained: the CSS and the script are inline, nothing is fetched from the network; the
 thumbnails are files in OUTDIR referenced relatively (the page works from a copy of OUTDIR).
-The rows are written as HTML (the page reads without its script); the script sorts by any
-column (click its heading) and filters by status and by "needs a look" (failed, or a result
-the job is not sure of), which also puts those rows first. The filter and the sort live in the
+The rows are written as HTML (the page reads without its script); the script puts the rows
+that need a look (failed, or a result the job is not sure of) first, sorts by any column
+(click its heading) and filters by status and by "needs a look". The filter and the sort live in the
 address's fragment (``report.html#status=failed&look=1&sort=time&desc=1``) so a link keeps
 them and a test can load the page in that state.
 """
@@ -50,7 +50,7 @@ function apply(){const s=state(),status=s.status||'all',look=s.look==='1';
  st.value=status;lk.checked=look;
  const col=heads.findIndex(h=>h.dataset.k===s.sort),desc=s.desc==='1';
  const rows=[...body.rows];
- rows.sort((a,b)=>{if(look){const d=b.dataset.look-a.dataset.look;if(d)return d}
+ rows.sort((a,b)=>{if(look||col<0){const d=b.dataset.look-a.dataset.look;if(d)return d}
   if(col<0)return a.dataset.i-b.dataset.i;
   const x=key(a,col),y=key(b,col);
   if(typeof x!==typeof y)return (typeof x==='number'?-1:1);
@@ -109,7 +109,7 @@ def _row(i, entry, quality_keys):
              + [f"NOT SURE: {u}" for u in entry.get("unsure") or []]]
     warns = entry.get("warnings") or []
     outs = " ".join(f'<a href="{html.escape(o)}">{html.escape(o)}</a>'
-                    for o in entry.get("outputs") or [])
+                    for o in entry.get("outputs") or []) if status == "ok" else "-"
     cells = [f'<td class="st">{html.escape(status)}</td>', _media(entry),
              f'<td class="path" title="{html.escape(entry.get("input") or "")}">'
              f'{html.escape(Path(entry.get("input") or "-").name)}</td>',

@@ -19,6 +19,7 @@ pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="needs chromium (python
 def report(tmp_path_factory):
     """Two retargets with thumbnails, one of them made unsure, and a broken input."""
     out, _, entries = run_in_process(tmp_path_factory.mktemp("report"), thumbnails=True)
+    assert entries[2]["input"].endswith("broken.bvh")
     entries[1]["unsure"] = ["unmapped: left arm"]   # as a partial map gives
     return write_report(out, "retarget", entries), entries
 
@@ -44,6 +45,9 @@ def test_one_row_per_task_with_its_thumbnail(report):
     dom = _dom(page)
     rows = _rows(dom)
     assert len(rows) == 3 and not any(hidden for _, hidden in rows)
+    # those that need a look first (failed, unsure), then in the manifest's order
+    names = [e["input"].rsplit("/", 1)[1] for e in entries]
+    assert [n for n, _ in rows] == [names[1], names[2], names[0]]
     thumbs = re.findall(r'<img class="thumb" src="([^"]+)"', dom)
     assert len(thumbs) == 2   # the broken input has none
     for src in thumbs:
