@@ -96,3 +96,29 @@ def test_bvh_export_samples_bezier_curves_between_keys(tmp_path):
     # the frames hold the curve's values (eased by the auto-clamped handles), not a line
     z = [clip.sample(t).get_euler("j1", degrees=True)[2] for t in times[:16]]
     assert z[3] < 60 * times[3] / 0.5 - 1 and z[15] == pytest.approx(60, abs=1e-6)
+
+
+def test_khronos_validator_accepts_bezier_exports(tmp_path):
+    import json
+    import subprocess
+    import warnings
+
+    from test_gltf_write import _validator
+    script = _validator()
+    a, b, c = hermite_curves()
+    q = Rotation.from_rotvec(np.radians([[0, 0, 0], [40, 10, 0], [0, 90, 30]])).as_quat()
+    tracks = {("j0", "translation"): Track.from_curves("translation", (a, b, c)),
+              ("j1", "scale"): Track.from_curves("scale", [Curve([0, 1], [1, 2], "constant")] * 3),
+              ("j2", "rotation"): Track("rotation", [0, 0.5, 1.0], q).with_interpolation("bezier")}
+    rig = cylinder_rig(with_clip=False)
+    rig.clips = {"c": Clip("c", rig.skeleton, tracks, duration=2.0)}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BezierResampledWarning)
+        out = save_gltf(rig, tmp_path / "b.glb")
+    run = subprocess.run(["node", script, str(out)], capture_output=True, text=True, timeout=120)
+    report = json.loads(run.stdout)
+    assert report["issues"]["numErrors"] == 0 and report["issues"]["numWarnings"] == 0, \
+        report["issues"]["messages"][:5]
+    import pygltflib
+    samplers = pygltflib.GLTF2().load(str(out)).animations[0].samplers
+    assert {s.interpolation for s in samplers} == {"CUBICSPLINE", "STEP", "LINEAR"}
