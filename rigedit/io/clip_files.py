@@ -26,10 +26,13 @@ from pathlib import Path, PurePosixPath
 from ..animation.clip_names import clip_file_stem, name_key
 from ..errors import RigFileError
 
-__all__ = ["ANIMATIONS", "plan_clip_files", "clip_entry", "remember_clip_files",
+__all__ = ["ANIMATIONS", "CLIP_SUFFIXES", "plan_clip_files", "clip_entry", "remember_clip_files",
            "loaded_clip_files"]
 
 ANIMATIONS = "animations"
+#: Clip files: rigedit's JSON clips and compressed clips (``.rgc``, a compressed clip of the
+#: rig is saved as one, :mod:`rigedit.io.compressed_file`).
+CLIP_SUFFIXES = (".json", ".rgc")
 
 def remember_clip_files(rig, files):
     """Record that ``rig``'s clips were read from ``files`` (``{clip name: path}``), in
@@ -53,7 +56,7 @@ def clip_entry(rel):
     if not isinstance(rel, str):
         return None
     parts = PurePosixPath(rel).parts
-    if (len(parts) == 2 and parts[0] == ANIMATIONS and parts[1].endswith(".json")
+    if (len(parts) == 2 and parts[0] == ANIMATIONS and parts[1].endswith(CLIP_SUFFIXES)
             and parts[1] not in (".", "..") and "\\" not in parts[1]):
         return parts[1]
     return None
@@ -140,9 +143,17 @@ def plan_clip_files(folder, rig, names):
         if name not in files:
             files[name] = clip_file_stem(name, used) + ".json"
             used.add(name_key(files[name]))
+    for name in names:   # a compressed clip is written as .rgc, a plain one as .json
+        suffix = ".rgc" if hasattr(rig.clips[name], "blob") else ".json"
+        if not files[name].endswith(suffix):
+            other = files[name].rsplit(".", 1)[0] + suffix
+            if name_key(other) in used:
+                other = clip_file_stem(name, used) + suffix
+            files[name] = other
+            used.add(name_key(other))
     kept = {name_key(f) for f in files.values()}
     stale = sorted(f for f in present if name_key(f) in ours and name_key(f) not in kept
-                   and f.endswith(".json"))
+                   and f.endswith(CLIP_SUFFIXES))
     return files, stale
 
 

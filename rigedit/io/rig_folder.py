@@ -20,7 +20,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RigFileError
+from .clip_files import CLIP_SUFFIXES
 from .clip_json import load_clip
+from .compressed_file import read_clip_file
 from .data import RigData, RigMeta, WeightsComputedWarning, build_rig
 from .frames import change_axes, resolve_folder_frames
 from .jsonfile import choice, name, read_json, relative_path
@@ -119,7 +121,7 @@ def find_rig_files(folder):
     if _exists(anim_dir):
         if not anim_dir.is_dir():
             raise RigFileError(anim_dir, "expected a folder of clip files, got a file")
-        animations = [p for p in list_folder(anim_dir) if p.suffix.lower() == ".json"]
+        animations = [p for p in list_folder(anim_dir) if p.suffix.lower() in CLIP_SUFFIXES]
     morphs = folder / manifest["morphs"] if "morphs" in manifest else None
     if morphs is not None and not _exists(morphs):
         raise RigFileError(folder / "rig.json", f"expected the morph targets it names "
@@ -186,11 +188,17 @@ def _read(folder):
         folder, skeleton, meta, vertices, files["manifest"])
     clips, sources = {}, {}
     for path in files["animations"]:
-        clip = load_clip(path, skeleton)
-        if clip.name in sources:
-            raise RigFileError(path, f"expected one file per clip name, got clip "
-                                     f"{clip.name!r} in both {sources[clip.name]} and {path}")
-        clips[clip.name], sources[clip.name] = clip, path
+        found = ([load_clip(path, skeleton)] if path.suffix.lower() == ".json"
+                 else list(read_clip_file(path, skeleton)[1].values()))
+        for clip in found:
+            if clip.name in sources:
+                raise RigFileError(path, f"expected one file per clip name, got clip "
+                                         f"{clip.name!r} in both {sources[clip.name]} and "
+                                         f"{path}")
+            clips[clip.name], sources[clip.name] = clip, path
+    if clip_change is not None and any(p.suffix.lower() == ".rgc" for p in sources.values()):
+        raise RigFileError(folder, "expected JSON clips in a folder whose skeleton changes "
+                                   "axes on reading, got a compressed (.rgc) clip")
     if clip_change is not None:   # rigedit's formats: skeleton and clips change together
         skeleton, clips = change_axes(skeleton, clips, clip_change)
     morphs = None if files["morphs"] is None else load_morphs(files["morphs"], len(vertices))

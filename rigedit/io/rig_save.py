@@ -47,7 +47,9 @@ from .atomic import check_output_folder, fsync_folder, write_error, write_json
 from .bundled import is_bundled
 from .clip_files import (ANIMATIONS, clip_entry, loaded_clip_files, plan_clip_files,
                          remember_clip_files)
+from ..compression import CompressedClip
 from .clip_json import save_clip
+from .compressed_file import save_compressed
 from .data import as_rig_data
 from .mesh import save_obj
 from .skeleton_json import save_skeleton
@@ -190,7 +192,11 @@ def _save(folder, rig, names, mesh_name):
             save_morphs(stage / "morphs.npz", morphs)
         save_skeleton(stage / "skeleton.json", rig.skeleton, up=rig.up)
         for clip in rig.clips.values():
-            save_clip(stage / ANIMATIONS / files[clip.name], clip)
+            if isinstance(clip, CompressedClip):
+                save_compressed(stage / ANIMATIONS / files[clip.name], rig.skeleton,
+                                {clip.name: clip})
+            else:
+                save_clip(stage / ANIMATIONS / files[clip.name], clip)
         clip_paths = {name: f"{ANIMATIONS}/{files[name]}" for name in sorted(files)}
         manifest = {"name": rig.name, "mesh": None if meshless else mesh_name,
                     "skeleton": "skeleton.json", "weights": "weights.npz", "up": rig.up,

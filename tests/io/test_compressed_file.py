@@ -87,3 +87,42 @@ def test_huge_claims_are_refused_before_allocating(tmp_path):
     bad.write_bytes(b"not a clip file at all")
     with pytest.raises(RigFileError, match="magic"):
         rigedit.load_rig(bad)
+
+
+def test_rig_folder_keeps_compressed_clips_beside_json_ones(tmp_path):
+    from builders import cylinder_rig
+
+    rig = cylinder_rig()
+    sk = rig.skeleton
+    rig.clips["take"] = mocap_clip(sk, 40)
+    packed = compress_clips(sk, {"take": rig.clips["take"]}, max_error=1e-4).clips["take"]
+    rig.clips["take"] = packed
+    folder = tmp_path / "rig"
+    rigedit.save_rig(rig, folder)
+    files = sorted(p.name for p in (folder / "animations").iterdir())
+    assert files == ["bend.json", "take.rgc"]
+    back = rigedit.load_rig(folder)
+    assert isinstance(back.clips["take"], CompressedClip)
+    assert back.clips["take"].blob == packed.blob
+    assert not isinstance(back.clips["bend"], CompressedClip)
+    # the clip made plain again: its .rgc is rigedit's stale file, replaced by a .json
+    back.clips["take"] = back.clips["take"].to_clip()
+    rigedit.save_rig(back, folder)
+    assert sorted(p.name for p in (folder / "animations").iterdir()) == ["bend.json",
+                                                                          "take.json"]
+    again = rigedit.load_rig(folder)
+    times = np.linspace(0, packed.duration, 9)
+    assert np.allclose(again.clips["take"].sample(times[3]).as_array(),
+                       packed.sample(times[3]).as_array(), atol=1e-9)
+
+
+def test_rig_folder_refuses_a_compressed_clip_of_other_joints(tmp_path):
+    from builders import cylinder_rig
+
+    rig = cylinder_rig()
+    rigedit.save_rig(rig, tmp_path / "rig")
+    other = chain(5, 0.1)
+    packed = compress_clips(other, {"x": mocap_clip(other, 10, name="x")}).clips
+    save_compressed(tmp_path / "rig" / "animations" / "x.rgc", other, packed)
+    with pytest.raises(RigFileError, match="x.rgc.*joints"):
+        rigedit.load_rig(tmp_path / "rig")
