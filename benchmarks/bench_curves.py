@@ -14,6 +14,13 @@ Cases are interleaved with the reference (A B A B ...) so load on the machine hi
 alike; it prints the median wall time and the best CPU time (``time.process_time``) per
 pose, and the ratios to ``plain``.
 
+Then, on a mocap clip (CMU 131_01.bvh from the shared test data, 994 keys per track, skipped
+when missing), what the graph editor does with dense keys, each the median of ``--repeat``
+runs beside the reference, the rotation track's own ``sample_many`` at the same 1000 times:
+``channels`` of one joint (the conversion to curves, uncached), ``ChannelView.sample`` of one
+rotation channel at 1000 times, and one ``CurveDrag.update`` (the clip changed and the pose
+sampled again).
+
 Run: ``.venv/bin/python benchmarks/bench_curves.py [--poses N]``.
 """
 from __future__ import annotations
@@ -76,6 +83,7 @@ def _time(fn, t):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--poses", type=int, default=300)
+    ap.add_argument("--repeat", type=int, default=9)
     args = ap.parse_args()
     plain, bezier = clips()
     pose = Pose(plain.skeleton)
@@ -102,6 +110,54 @@ def main():
         print(f"{name:>18}: {wall * 1e3:7.3f} ms wall, {cpu * 1e3:7.3f} ms CPU | plain "
               f"{rwall * 1e3:7.3f} ms wall, {rcpu * 1e3:7.3f} ms CPU | ratio "
               f"{wall / rwall:5.2f} wall, {cpu / max(rcpu, 1e-9):5.2f} CPU")
+    mocap(args.repeat)
+
+
+def _median(fn, repeat):
+    out = []
+    for _ in range(repeat):
+        w = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - w)
+    return float(np.median(out))
+
+
+def mocap(repeat):
+    """The graph editor's operations on a dense mocap clip (see the module notes)."""
+    import warnings
+    from pathlib import Path
+
+    import rigedit
+    from rigedit.editor import graph_commands as gc
+    from rigedit.editor.document import Document
+
+    path = Path("/work/shared/data/bvh-cmu/131_01.bvh")
+    if not path.is_file():
+        print(f"mocap: skipped ({path} is missing)")
+        return
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        doc = Document(rigedit.load_rig(path))
+    joint = doc.skeleton.names[1]
+    track = doc.clip.tracks[(joint, "rotation")]
+    times = np.linspace(0, doc.clip.duration, 1000)
+    ref = _median(lambda: track.sample_many(times), repeat)
+
+    def convert():
+        gc._CONVERTED.clear()
+        return gc.channels(doc, [joint])
+
+    view = next(v for v in convert() if v.id.channel == "rotation" and v.id.axis == 2)
+    drag = gc.CurveDrag(doc, "bench")
+    moved = view.curve.with_keys_moved([10], 0.0, 5.0)
+    cases = {"channels (convert)": convert, "view.sample 1000": lambda: view.sample(times),
+             "CurveDrag.update": lambda: drag.update({view.id: moved})}
+    print(f"mocap {path.name}: {len(track)} keys per track, {len(doc.clip.tracks)} tracks; "
+          f"reference track.sample_many(1000 times) {ref * 1e3:.2f} ms")
+    for name, fn in cases.items():
+        t = _median(fn, repeat)
+        print(f"{name:>18}: {t * 1e3:7.2f} ms median wall, ratio {t / ref:6.1f}")
+    drag.cancel()
 
 
 if __name__ == "__main__":
