@@ -43,7 +43,8 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from anim_reader import RAW_BYTES_PER_KEY, GltfAnimations, virtual_vertex_error  # noqa: E402
+from anim_reader import (RAW_BYTES_PER_KEY, GltfAnimations, _trs_matrix,  # noqa: E402
+                         virtual_vertex_error)
 
 DATA = HERE.parent.parent / "shared" / "data"
 SHELL = 0.03
@@ -55,8 +56,8 @@ BVH_INPUTS = ["bvh-cmu/131_01.bvh", "bvh-bandai/dataset-1_run_normal_001.bvh",
     [f"bvh-library/bandai-2/{p.name}" for p in sorted((DATA / "bvh-library/bandai-2").glob("*.bvh"))] + \
     [f"bvh-library/cmu-iclone/{p.name}" for p in sorted((DATA / "bvh-library/cmu-iclone").glob("*.bvh"))]
 QUICK = ["threejs-characters/Xbot.glb", "bvh-cmu/131_01.bvh"]
-#: (label, max error in metres) of the rigedit runs
-RIGEDIT_RUNS = [("rigedit 0.01 cm", 1e-4), ("rigedit 0.05 cm", 5e-4)]
+#: (label, max error in metres) of the rigedit glTF runs
+RIGEDIT_RUNS = [("rigedit glTF 0.01 cm", 1e-4), ("rigedit glTF 0.05 cm", 5e-4)]
 
 
 # ---------------------------------------------------------------------- measuring
@@ -92,14 +93,25 @@ def measure_gltf(ref, path):
     return ref.raw / cand.animation_bytes(), float(e.max()), float(np.percentile(e, 99))
 
 
-def _fk_of_local(ref, skeleton, local):
-    """(F, J, 4, 4) world matrices of rigedit local rows through the reference file's tree:
-    each joint's local TRS replaces its node's (so non-joint ancestors still count)."""
-    f = ref.file
-    rows = np.repeat(f.rest[None], len(local), axis=0)
-    for j, name in enumerate(skeleton.names):
-        rows[:, f.names.index(name)] = local[:, j]
-    return f.world(rows)[:, [f.names.index(n) for n in ref.names]]
+def skeleton_world(parents, local):
+    """(F, J, 4, 4) model matrices of (F, J, 10) local rows over a parent array (this
+    script's FK: rigedit's skeleton has the file's non-joint ancestors folded into its roots,
+    so its model space is the file's world space)."""
+    mats = _trs_matrix(local)
+    out = np.empty_like(mats)
+    done = np.zeros(len(parents), bool)
+    while not done.all():
+        for j in np.flatnonzero(~done):
+            p = parents[j]
+            if p < 0 or done[p]:
+                out[:, j] = mats[:, j] if p < 0 else out[:, p] @ mats[:, j]
+                done[j] = True
+    return out
+
+
+def _joint_columns(ref, skeleton):
+    """Indices of the reference's skin joints in rigedit's skeleton."""
+    return [skeleton.names.index(n) for n in ref.names]
 
 
 # ---------------------------------------------------------------------- the three tools
@@ -113,40 +125,41 @@ def run_tool(cmd):
 
 def rigedit_rows(ref, source, tmp, rows):
     import rigedit
-    from rigedit.compression import compress_clips
-    from rigedit.io.gltf_write_compact import save_gltf_compressed
+    from rigedit.io.gltf_compress import save_gltf_compressed_rig
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         rig = rigedit.load_rig(source)
     for label, max_error in RIGEDIT_RUNS:
-        t0 = time.perf_counter()
-        result = compress_clips(rig.skeleton, rig.clips, max_error=max_error, shell=SHELL,
-                                target="gltf")
-        dt = time.perf_counter() - t0
-        out = tmp / f"{source.stem}_{max_error:g}.glb"
-        save_gltf_compressed(rig, out, {n: c.to_clip() for n, c in result.clips.items()})
-        rows.append((label, *measure_gltf(ref, out), dt, float(result.report.max_error)))
-    own_format_row(ref, rig, tmp, rows)
+        for meshopt in (False, True):
+            out = tmp / f"{source.stem}_{max_error:g}{'_meshopt' if meshopt else ''}.glb"
+            t0 = time.perf_counter()
+            report = save_gltf_compressed_rig(rig, out, max_error=max_error, shell=SHELL,
+                                              meshopt=meshopt)
+            dt = time.perf_counter() - t0
+            rows.append((label + (" meshopt" if meshopt else ""), *measure_gltf(ref, out), dt,
+                         report.max_error))
+    own_format_row(ref, rig, rows)
 
 
-def own_format_row(ref, rig, tmp, rows):
-    """rigedit's own compressed clip file at 0.01 cm, decoded by rigedit, FK here."""
+def own_format_row(ref, rig, rows):
+    """rigedit's own compressed clips at 0.01 and 0.05 cm, decoded by rigedit's decoder (the
+    one row the independent reader cannot read), FK and error here."""
     from rigedit.compression import compress_clips
 
-    t0 = time.perf_counter()
-    result = compress_clips(rig.skeleton, rig.clips, max_error=1e-4, shell=SHELL,
-                            target="rigedit")
-    dt = time.perf_counter() - t0
-    size = sum(c.nbytes for c in result.clips.values())
-    sk = rig.skeleton
-    frames = {}
-    for name, clip in result.clips.items():
-        t = ref.times[name]
-        frames[name] = _fk_of_local(ref, sk, clip.sample_many(t))
-    e = ref.errors(lambda a, t: frames[a])
-    rows.append(("rigedit own format 0.01 cm", ref.raw / size, float(e.max()),
-                 float(np.percentile(e, 99)), dt, float(result.report.max_error)))
+    for max_error in (1e-4, 5e-4):
+        t0 = time.perf_counter()
+        result = compress_clips(rig.skeleton, rig.clips, max_error=max_error, shell=SHELL,
+                                target="rigedit")
+        dt = time.perf_counter() - t0
+        cols = _joint_columns(ref, rig.skeleton)
+        frames = {name: skeleton_world(rig.skeleton.parents,
+                                       clip.sample_many(ref.times[name]))[:, cols]
+                  for name, clip in result.clips.items()}
+        e = ref.errors(lambda a, t: frames[a])
+        rows.append((f"rigedit own format {max_error * 100:g} cm",
+                     ref.raw / result.report.compressed_bytes, float(e.max()),
+                     float(np.percentile(e, 99)), dt, float(result.report.max_error)))
 
 
 def tool_rows(ref, source, tmp, tools, rows):
@@ -174,12 +187,18 @@ def as_gltf(path, tmp):
 
 
 # ---------------------------------------------------------------------- decode speed
-def decode_speed(sources, tmp):
-    """Seconds for one pose and per pose in a batch of 1,000, rigedit's decoder."""
+#: Skeletons of 31, 67 and 101 joints for the decode timings.
+DECODE_INPUTS = ["bvh-cmu/131_01.bvh", "threejs-characters/Xbot.glb",
+                 "bvh-library/cmu-iclone/002_01.bvh"]
+
+
+def decode_speed(sources):
+    """Microseconds for one pose (one call) and per pose in a batch of 1,000 (one call),
+    rigedit's decoder (compiled kernels, warmed up first), its first clip at 0.01 cm."""
     import rigedit
     from rigedit.compression import compress_clips
 
-    print("\ndecode (rigedit's own format, 0.01 cm):")
+    print("\ndecode (rigedit's own format, 0.01 cm, random times):")
     for source in sources:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -190,13 +209,14 @@ def decode_speed(sources, tmp):
         clip = result.clips[name]
         pose = rigedit.Pose(rig.skeleton)
         t = np.random.default_rng(0).uniform(0, rig.clips[name].duration, 1000)
-        clip.sample(t[0], pose)
+        for _ in range(3):   # the first calls compile (or load) the kernels
+            clip.sample(t[0], pose)
+            clip.sample_many(t)
         n = 2000
         t0 = time.perf_counter()
         for i in range(n):
             clip.sample(t[i % 1000], pose)
         one = (time.perf_counter() - t0) / n
-        clip.sample_many(t)
         t0 = time.perf_counter()
         for _ in range(20):
             clip.sample_many(t)
@@ -218,30 +238,19 @@ def main(argv=None):
           f"error: 3 cm shell, world space, every source key; ratio: raw / animation bytes")
     print(f"{'input':<40} {'tool':<28} {'ratio':>7} {'max cm':>8} {'p99 cm':>8} "
           f"{'time s':>7} {'report max cm':>13}")
-    exported = {}
     for rel in inputs:
         source = as_gltf(DATA / rel, tmp)
-        exported[rel] = source
         ref = Reference(source)
         if not ref.times:
             continue
         rows = []
-        try:
-            rigedit_rows(ref, source, tmp, rows)
-        except ImportError as exc:
-            print(f"  rigedit: {exc}")
+        rigedit_rows(ref, source, tmp, rows)
         tool_rows(ref, source, tmp, args.tools, rows)
         for label, ratio, emax, p99, dt, said in rows:
             said = "" if said is None else f"{said * 100:.4f}"
             print(f"{Path(rel).name:<40} {label:<28} {ratio:7.1f} {emax * 100:8.4f} "
                   f"{p99 * 100:8.4f} {dt:7.2f} {said:>13}")
-    speed = [exported[k] for k in ("bvh-cmu/131_01.bvh", "bvh-library/cmu-iclone/002_01.bvh")
-             if k in exported]
-    if speed:
-        try:
-            decode_speed(speed, tmp)
-        except ImportError as exc:
-            print(f"  rigedit: {exc}")
+    decode_speed([DATA / rel for rel in DECODE_INPUTS if (DATA / rel).is_file()])
     if args.out is None:
         shutil.rmtree(tmp, ignore_errors=True)
 

@@ -33,7 +33,8 @@ from ..compression.frames import frame_times
 from ..compression.report import RAW_BYTES_PER_JOINT_FRAME, ClipRow
 from ..errors import RigFileError
 from .gltf_write import _float32_times, save_gltf
-from .gltf_write_compact import CompactAnimations, decoded_rows
+from .gltf_write_compact import (CompactAnimations, decoded_rows, is_rest, rest_value,
+                                 same_channels)
 
 __all__ = ["ATTEMPTS", "as_read", "slerp_keys", "fit_clips", "save_gltf_compressed_rig"]
 
@@ -59,7 +60,7 @@ def as_read(clip):
     decoded (:func:`~rigedit.io.gltf_write_compact.decoded_rows`)."""
     tracks = {}
     for key, tr in clip.tracks.items():
-        kind, rows = decoded_rows(tr)
+        kind, rows = decoded_rows(tr, is_rest(tr, rest_value(clip.skeleton, *key)))
         times = _float32_times(tr.times).astype(np.float64)
         tangents, mode = None, _MODES[kind]
         if kind == "CUBICSPLINE":
@@ -108,9 +109,17 @@ def fit_clips(skeleton, clips, max_error=1e-4, shell=0.03, mesh=None):
     """
     start = time.perf_counter()
     report = CompressionReport(max_error, shell, "gltf")
-    keys, errors = {}, []
+    keys, attempts = {}, {}
     for name, clip in clips.items():
-        keys[name], err, attempts = _fit_one(skeleton, name, clip, max_error, shell, mesh)
+        keys[name], _, attempts[name] = _fit_one(skeleton, name, clip, max_error, shell, mesh)
+    keys = same_channels(keys)   # what the writer writes: measured again as read
+    errors = []
+    for name, clip in clips.items():
+        err = ErrorMeter(skeleton, clip, frame_times(clip), shell, mesh).error(
+            as_read(keys[name]))
+        if err.max() > max_error:
+            raise ValueError(f"clip {name!r}: {err.max():.3g} m over max_error {max_error:g} m "
+                             "once every clip keys the same channels")
         errors.append(err)
         tracks = keys[name].tracks.values()
         constant = sum(len(tr) == 1 for tr in tracks)
@@ -119,8 +128,9 @@ def fit_clips(skeleton, clips, max_error=1e-4, shell=0.03, mesh=None):
             float(np.percentile(err, 99)), err.shape[0] * len(skeleton) *
             RAW_BYTES_PER_JOINT_FRAME, 0, {}, {"animated": len(tracks) - constant,
                                               "constant": constant,
-                                              "omitted": len(clip.tracks) - len(tracks)},
-            sum(len(tr) for tr in tracks if len(tr) > 1), attempts))
+                                              "omitted": max(len(clip.tracks) - len(tracks),
+                                                             0)},
+            sum(len(tr) for tr in tracks if len(tr) > 1), attempts[name]))
     return keys, report.finish(errors, time.perf_counter() - start)
 
 

@@ -14,8 +14,10 @@ decoded). What is written, all glTF 2.0 core so every viewer opens it:
   Translations and scales are float32 (the spec allows nothing else for them).
 - one time accessor per distinct list of key times (float32 bytes), shared by every sampler
   with those times, across clips too.
-- a track with one key where the node's rest TRS is that value is left out (the node stays
-  at rest); another one-key track is written as one key.
+- every animation keys the same channels (:func:`same_channels`): a channel at its rest in
+  every clip is left out (the node stays at rest), one that moves in some clip is keyed in
+  all, with one key at the rest (float32, exact) where a clip leaves it at rest; another
+  one-key track is written as one key.
 - a clip whose keys all end before its duration gets a hold key at the duration on one
   LINEAR/STEP sampler, so viewers that take an animation's length from its keys play it for
   its whole duration (rigedit reads ``extras.rigedit.duration``).
@@ -34,10 +36,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..animation.clip import Clip, Track
 from ..errors import RigFileError
 
 __all__ = ["CompactAnimations", "save_gltf_compressed", "meshopt_available", "decoded_rows",
-           "MESHOPT"]
+           "same_channels", "is_rest", "rest_value", "MESHOPT"]
 
 MESHOPT = "EXT_meshopt_compression"
 _FLOAT, _SHORT = 5126, 5122
@@ -87,18 +90,24 @@ def _shorts(channel, rows):
     return np.clip(np.round(rows * _SHORT_SCALE), -32767, 32767).astype("<i2")
 
 
-def decoded_rows(track):
+def decoded_rows(track, exact=False):
     """``(glTF interpolation, (N, C) output rows as a reader decodes them)`` of what the writer
-    stores for ``track`` (normalised SHORT rotations, float32 otherwise)."""
+    stores for ``track`` (normalised SHORT rotations, float32 otherwise; float32 for all when
+    ``exact``: a one-key track at the rest)."""
     kind = _kind(track)
     rows = _outputs(track, kind)
-    ints = _shorts(track.channel, rows)
+    ints = None if exact else _shorts(track.channel, rows)
     if ints is not None:
         return kind, np.maximum(ints / _SHORT_SCALE, -1.0)
     return kind, rows.astype(np.float32).astype(np.float64)
 
 
-def _is_rest(track, rest):
+def rest_value(skeleton, joint, channel):
+    """The rest value of one channel of one joint."""
+    return getattr(skeleton, f"rest_{channel}")[skeleton.joint_index(joint)]
+
+
+def is_rest(track, rest):
     """Whether a one-key track holds the node's rest value (a rotation up to its sign)."""
     if len(track.times) != 1:
         return False
@@ -106,6 +115,30 @@ def _is_rest(track, rest):
     if track.channel == "rotation":
         return min(np.abs(v - rest).max(), np.abs(v + rest).max()) <= REST_TOLERANCE
     return np.abs(v - rest).max() <= REST_TOLERANCE
+
+
+def same_channels(clips):
+    """Every clip with the same channels: those that hold something other than the rest in
+    some clip (a channel at its rest everywhere is left out); a clip without one of them, or
+    with it at the rest, gets one key at the rest.
+
+    Why: a viewer that plays one animation after another may keep, on a channel the new one
+    does not key, what the old one left there (Blender does); the spec's "the node's own TRS"
+    then only holds if every animation keys the same channels. One rest key costs 8-16
+    bytes and a shared one-float time accessor.
+    """
+    keyed = {}
+    for clip in clips.values():
+        for (joint, channel), tr in clip.tracks.items():
+            if not is_rest(tr, rest_value(clip.skeleton, joint, channel)):
+                keyed.setdefault((joint, channel), None)
+    out = {}
+    for name, clip in clips.items():
+        sk = clip.skeleton
+        tracks = {key: clip.tracks.get(key) or Track(key[1], [0.0], [rest_value(sk, *key)])
+                  for key in keyed}
+        out[name] = Clip(clip.name, sk, tracks, clip.duration, clip.loop, clip.morph_tracks)
+    return out
 
 
 class CompactAnimations:
@@ -145,8 +178,8 @@ class CompactAnimations:
         self._views.append((w.doc["accessors"][accessor]["bufferView"], self._clip, kind))
         return accessor
 
-    def _output(self, w, channel, rows):
-        ints = _shorts(channel, rows)
+    def _output(self, w, channel, rows, exact=False):
+        ints = None if exact else _shorts(channel, rows)
         if ints is not None:
             acc = {"bufferView": w.view(ints.tobytes()), "componentType": _SHORT,
                    "normalized": True, "count": len(ints), "type": "VEC4"}
@@ -166,34 +199,35 @@ class CompactAnimations:
         return out
 
     # ------------------------------------------------------------------ animations
-    def _sampler(self, w, track, end):
+    def _sampler(self, w, track, end, exact):
         kind = _kind(track)
         times, rows = track.times, _outputs(track, kind)
         if end is not None:    # a hold key at the clip's end: the same curve, the whole length
             times, rows = np.r_[times, end], np.vstack([rows, rows[-1:]])
-        return {"input": self._input(w, times), "output": self._output(w, track.channel, rows),
+        return {"input": self._input(w, times),
+                "output": self._output(w, track.channel, rows, exact),
                 "interpolation": kind}
 
     def write(self, w, rig, joints, mesh_node=None):
         """Add one animation per clip to the writer ``w`` (``joints``: the joint nodes)."""
         from .gltf_write import clip_animation
 
-        sk = rig.skeleton
         self._doc = w.doc
-        for name, clip in self.clips.items():
+        for name, clip in same_channels(self.clips).items():
             self._clip = name
-            drop = {id(tr) for (joint, channel), tr in clip.tracks.items()
-                    if _is_rest(tr, getattr(sk, f"rest_{channel}")[sk.joint_index(joint)])}
-            kept = [tr for tr in clip.tracks.values() if id(tr) not in drop]
-            last = max((tr.times[-1] for tr in kept), default=0.0)
+            sk = clip.skeleton
+            # a rest key is written float32, exactly (it was never quantised)
+            exact = {id(tr) for key, tr in clip.tracks.items()
+                     if is_rest(tr, rest_value(sk, *key))}
+            last = max((tr.times[-1] for tr in clip.tracks.values()), default=0.0)
             holder = None
             if clip.duration > last + 1e-6:
-                holder = next((tr for tr in kept if _kind(tr) != "CUBICSPLINE"
+                holder = next((tr for tr in clip.tracks.values() if _kind(tr) != "CUBICSPLINE"
                                and tr.times[-1] == last), None)
             clip_animation(w, rig, name, clip, joints, mesh_node,
-                           lambda w, tr, drop=drop, holder=holder, end=clip.duration:
-                           None if id(tr) in drop else
-                           self._sampler(w, tr, end if tr is holder else None))
+                           lambda w, tr, exact=exact, holder=holder, end=clip.duration:
+                           self._sampler(w, tr, end if tr is holder else None,
+                                         id(tr) in exact))
 
     def finish(self, w):
         """Rewrite the buffers once everything is written (meshopt), else nothing."""

@@ -98,7 +98,9 @@ def test_rotations_are_normalised_shorts_and_times_are_shared(tmp_path, rig, cli
     for anim in g.animations:
         for ch in anim.channels:
             acc = g.accessors[anim.samplers[ch.sampler].output]
-            if ch.target.path == "rotation":
+            if ch.target.path == "rotation" and acc.componentType == 5126:
+                assert acc.count == 1           # a rest key of a channel another clip moves
+            elif ch.target.path == "rotation":
                 assert (acc.componentType, acc.normalized) == (5122, True)
                 assert g.bufferViews[acc.bufferView].byteLength == 8 * acc.count
             else:
@@ -133,6 +135,27 @@ def test_constant_tracks(tmp_path, rig, clips):
     rest_joint, scaled_joint = one
     assert rest_joint not in scales and rest_joint in nodes
     assert g.accessors[scales[scaled_joint].output].count == 1
+
+
+def test_every_animation_keys_the_same_channels(tmp_path, rig):
+    """A channel one clip moves gets one exact rest key in a clip that leaves it alone (a
+    viewer switching animations may keep what the last one left on an unkeyed channel)."""
+    sk = rig.skeleton
+    moved, still = sk.names[3], sk.names[4]
+    turn = [[0, 0, 0, 1], [0, 0.2588190, 0, 0.9659258]]
+    clips = {"a": Clip("a", sk, {(moved, "rotation"): Track("rotation", [0, 1], turn)}),
+             "b": Clip("b", sk, {(still, "rotation"): Track("rotation", [0, 1], turn)})}
+    out = tmp_path / "s.glb"
+    save_gltf_compressed(rig, out, clips)
+    g = _doc(out)
+    for anim in g.animations:
+        keyed = {g.nodes[c.target.node].name for c in anim.channels}
+        assert keyed == {moved, still}
+    back = rigedit.load_rig(out)
+    rest = sk.rest_rotation[sk.joint_index(still)]
+    got = back.clips["a"].tracks[(still, "rotation")]
+    assert len(got.times) == 1
+    assert np.abs(got.values[0] - rest).max() < 1e-7     # float32, not the int16 grid
 
 
 def test_the_duration_is_kept_for_viewers(tmp_path, rig, clips):
