@@ -15,7 +15,9 @@ animated tracks       varint A, then A track headers:
                       2 scale) | rotation mode << 2 (0-3 fixed dropped component, 4 per key);
                       varint K (keys, 2..F); uint8 D (bits per key-frame step, 0: every
                       frame is a key); per-key rotation: uint8 B (bits of all three
-                      components); else 3 uint8 bits, 3 float32 lo, 3 float32 extent
+                      components); fixed rotation: 3 uint8 bits, 3 uint16 lo, 3 uint16
+                      extent (on [-1, 1]: lo16 * 2 / 65535 - 1, ext16 * 2 / 65535);
+                      translation, scale: 3 uint8 bits, 3 float32 lo, 3 float32 extent
 bit stream            varint n words, n uint32 words: first every animated track's K - 1
                       key-frame steps (D bits each; the first key is frame 0), then every
                       animated track's K keys, each [2 bits dropped component, per-key
@@ -33,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .bits import MAX_FIELD_BITS, pack
-from .quantise import PER_KEY, VectorCode
+from .quantise import PER_KEY, VectorCode, unit_range_codes, unit_range_values
 
 __all__ = ["CHANNEL_CODES", "EncodedTrack", "ClipLayout", "write_clip", "read_clip",
            "LayoutError", "ByteReader", "varint"]
@@ -126,8 +128,12 @@ def write_clip(layout):
             out += bytes([int(tr.code.bits[0])])
         else:
             out += bytes(int(b) for b in tr.code.bits)
-            out += np.asarray(tr.code.lo, dtype="<f4").tobytes()
-            out += np.asarray(tr.code.ext, dtype="<f4").tobytes()
+            if tr.channel == "rotation":
+                lo16, ext16 = unit_range_codes(tr.code.lo, tr.code.ext)
+                out += lo16.astype("<u2").tobytes() + ext16.astype("<u2").tobytes()
+            else:
+                out += np.asarray(tr.code.lo, dtype="<f4").tobytes()
+                out += np.asarray(tr.code.ext, dtype="<f4").tobytes()
         if dbits:
             fields.append(steps)
             widths.append(np.full(len(steps), dbits))
@@ -249,8 +255,12 @@ def read_clip(blob, num_joints):
             ext = np.full(3, 2 * np.sqrt(0.5), dtype=np.float32)
         else:
             bits = np.frombuffer(r.take(3, "component bits"), dtype=np.uint8).astype(np.int64)
-            lo = r.floats(3, "range low").astype(np.float32)
-            ext = r.floats(3, "range extent").astype(np.float32)
+            if channel == "rotation":
+                lo, ext = unit_range_values(r.floats(3, "range low", "<u2"),
+                                            r.floats(3, "range extent", "<u2"))
+            else:
+                lo = r.floats(3, "range low").astype(np.float32)
+                ext = r.floats(3, "range extent").astype(np.float32)
         if np.any(bits > MAX_FIELD_BITS) or not (np.all(np.isfinite(lo))
                                                  and np.all(np.isfinite(ext))):
             raise LayoutError(f"clip {name!r}: a track's range or bits are not valid")
