@@ -29,16 +29,16 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["INTERPOLATIONS", "HANDLE_TYPES", "EASINGS", "AUTO_TYPES", "KEY_TOLERANCE", "Curve",
-           "bezier_points", "solve_u", "ONE_KEY_HANDLE"]
+from .bezier import INTERPOLATIONS, bezier_points, evaluate, solve_u
+from .curve_handles import ONE_KEY_HANDLE, place_handles, spans
 
-INTERPOLATIONS = ("constant", "linear", "bezier")
+__all__ = ["INTERPOLATIONS", "HANDLE_TYPES", "EASINGS", "AUTO_TYPES", "KEY_TOLERANCE", "Curve",
+           "bezier_points", "solve_u", "evaluate", "ONE_KEY_HANDLE"]
+
 HANDLE_TYPES = ("auto", "auto_clamped", "aligned", "free", "vector")
 EASINGS = ("ease_in", "ease_out", "ease_in_out")
 #: Types whose handles the curve places itself (recomputed after every edit).
 AUTO_TYPES = ("auto", "auto_clamped", "vector")
-#: Time length (seconds) of the handles of a key without neighbours.
-ONE_KEY_HANDLE = 1.0 / 3.0
 #: Two key times closer than this (seconds) are the same key (tracks use the same).
 KEY_TOLERANCE = 1e-6
 #: Easing presets make the eased handle this fraction of its segment long (flat).
@@ -108,12 +108,7 @@ class Curve:
 
     # ------------------------------------------------------------------ handles
     def _spans(self):
-        """(K,) time spans before and after each key (the other side's at an end key)."""
-        if len(self.times) == 1:
-            one = np.array([ONE_KEY_HANDLE])
-            return one, one
-        dt = np.diff(self.times)
-        return np.r_[dt[0], dt], np.r_[dt, dt[-1]]
+        return spans(self.times)
 
     def _flat_handles(self):
         before, after = self._spans()
@@ -134,43 +129,10 @@ class Curve:
             np.maximum(pts[:, 0], self.times)
         return pts
 
-    def auto_slopes(self, clamped):
-        """(K,) value-per-second slopes of the automatic handles: the neighbours' secant
-        (``auto``), flattened at extremes and limited so the handles stay within the
-        neighbouring keys' values (``clamped``); 0 at the end keys."""
-        t, v = self.times, self.values
-        m = np.zeros(len(t))
-        if len(t) < 3:
-            return m
-        dv_a, dv_b = v[1:-1] - v[:-2], v[2:] - v[1:-1]
-        dt_a, dt_b = t[1:-1] - t[:-2], t[2:] - t[1:-1]
-        inner = (v[2:] - v[:-2]) / (t[2:] - t[:-2])
-        if clamped:
-            extreme = dv_a * dv_b <= 0
-            # a handle a third of the span long reaches m * span / 3: within the key's
-            # neighbour when |m| <= 3 |dv| / span, on both sides
-            limit = np.minimum(3 * np.abs(dv_a) / dt_a, 3 * np.abs(dv_b) / dt_b)
-            inner = np.where(extreme, 0.0, np.clip(inner, -limit, limit))
-        m[1:-1] = inner
-        return m
-
     def _place_handles(self):
         """Recompute the automatic (auto, auto_clamped, vector) handles in place."""
-        t, v = self.times, self.values
-        before, after = self._spans()
-        slope = {"auto": self.auto_slopes(False), "auto_clamped": self.auto_slopes(True)}
-        prev_v = np.r_[v[0], v[:-1]]
-        next_v = np.r_[v[1:], v[-1]]
-        for side, types, span, sign, other in (("left", self.left_type, before, -1, prev_v),
-                                               ("right", self.right_type, after, 1, next_v)):
-            pts = getattr(self, side)
-            for name, m in slope.items():
-                mask = types == name
-                pts[mask, 0] = t[mask] + sign * span[mask] / 3
-                pts[mask, 1] = v[mask] + sign * m[mask] * span[mask] / 3
-            mask = types == "vector"
-            pts[mask, 0] = t[mask] + sign * span[mask] / 3
-            pts[mask, 1] = v[mask] + (other[mask] - v[mask]) / 3
+        place_handles(self.times, self.values, self.left, self.right, self.left_type,
+                      self.right_type)
 
     # ------------------------------------------------------------------ sampling
     def __len__(self):
@@ -405,101 +367,3 @@ def _clamp_shift(times, idx, dt):
     lo, hi = _bounds(times, idx)
     t = times[idx]
     return float(np.clip(dt, np.max(lo + MIN_GAP - t), np.min(hi - MIN_GAP - t)))
-
-
-def bezier_points(times, values, left, right):
-    """Control points of each segment of a curve, time extents corrected.
-
-    Parameters
-    ----------
-    times, values : (K,) float
-    left, right : (K, 2) float
-
-    Returns
-    -------
-    points : (K - 1, 4, 2) float
-        Per segment: key k, its out-handle, key k + 1's in-handle, key k + 1; the handles
-        scaled towards their keys where their time extents overlap (sum over the segment's
-        duration), so that x(u) is monotone.
-    """
-    p0 = np.stack([times[:-1], values[:-1]], axis=1)
-    p3 = np.stack([times[1:], values[1:]], axis=1)
-    h1 = right[:-1] - p0
-    h2 = left[1:] - p3
-    dt = p3[:, 0] - p0[:, 0]
-    reach = np.maximum(h1[:, 0], 0) - np.minimum(h2[:, 0], 0)
-    f = np.where(reach > dt, dt / np.maximum(reach, 1e-300), 1.0)[:, None]
-    return np.stack([p0, p0 + h1 * f, p3 + h2 * f, p3], axis=1)
-
-
-def solve_u(x, t, iterations=30):
-    """Parameters u in [0, 1] with ``x(u) = t`` for monotone cubic Beziers.
-
-    Parameters
-    ----------
-    x : (N, 4) float
-        The time control points of each segment.
-    t : (N,) float
-        Times inside each segment.
-
-    Returns
-    -------
-    u : (N,) float
-        Newton steps from the linear guess, kept inside a shrinking bisection bracket (a step
-        leaving it bisects), until every residual is under 1e-12 of the segment's duration.
-    """
-    x0, x1, x2, x3 = x[:, 0], x[:, 1], x[:, 2], x[:, 3]
-    # power basis: x(u) = a u^3 + b u^2 + c u + x0
-    c = 3 * (x1 - x0)
-    b = 3 * (x2 - 2 * x1 + x0)
-    a = x3 - x0 - c - b
-    span = np.maximum(x3 - x0, 1e-300)
-    u = np.clip((t - x0) / span, 0.0, 1.0)
-    lo, hi = np.zeros_like(u), np.ones_like(u)
-    tol = 1e-12 * span
-    for _ in range(iterations):
-        f = ((a * u + b) * u + c) * u + x0 - t
-        if np.all(np.abs(f) <= tol):
-            break
-        lo = np.where(f < 0, u, lo)
-        hi = np.where(f > 0, u, hi)
-        d = (3 * a * u + 2 * b) * u + c
-        with np.errstate(divide="ignore", invalid="ignore"):
-            step = u - f / d
-        bad = ~np.isfinite(step) | (step <= lo) | (step >= hi)
-        u = np.where(bad, 0.5 * (lo + hi), step)
-    return u
-
-
-def evaluate(seg, interpolation, t):
-    """Values of segments at times inside them.
-
-    Parameters
-    ----------
-    seg : (N, 4, 2) float
-        Control points (:func:`bezier_points`) of the segment each time falls in.
-    interpolation : (N,) str or (N,) int
-        Names from :data:`INTERPOLATIONS` or their indices.
-    t : (N,) float
-
-    Returns
-    -------
-    values : (N,) float
-    """
-    code = np.asarray(interpolation)
-    if code.dtype == object:
-        code = np.array([INTERPOLATIONS.index(n) for n in code], dtype=np.int8)
-    p0, p3 = seg[:, 0], seg[:, 3]
-    frac = (t - p0[:, 0]) / np.maximum(p3[:, 0] - p0[:, 0], 1e-300)
-    out = np.where(t >= p3[:, 0], p3[:, 1], p0[:, 1])        # constant (the last key at its end)
-    lin = code == 1
-    out[lin] = p0[lin, 1] + (p3[lin, 1] - p0[lin, 1]) * frac[lin]
-    bez = code == 2
-    if bez.any():
-        s = seg[bez]
-        u = solve_u(s[:, :, 0], t[bez])
-        w = 1 - u
-        y = s[:, :, 1]
-        out[bez] = (w ** 3 * y[:, 0] + 3 * w * w * u * y[:, 1] + 3 * w * u * u * y[:, 2]
-                    + u ** 3 * y[:, 3])
-    return out
