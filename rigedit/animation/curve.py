@@ -198,9 +198,10 @@ class Curve:
     def with_handle(self, index, side, point):
         """Key ``index``'s ``side`` (``left``/``right``) handle at ``point`` (time, value).
 
-        An automatic handle that is dragged becomes ``aligned`` (both sides, as Blender does);
-        an aligned handle's other side turns to stay collinear, keeping its length; a free
-        handle moves alone. The time is clamped to the key's side.
+        An auto or auto_clamped handle that is dragged becomes ``aligned`` (with the other side
+        when that is auto too), a vector handle ``free``, as in Blender; an aligned handle's
+        other side turns to stay collinear, keeping its length; a free handle moves alone.
+        The time is clamped to the key's side.
         """
         if side not in ("left", "right"):
             raise ValueError(f"curve: expected side 'left' or 'right', got {side!r}")
@@ -208,9 +209,11 @@ class Curve:
         other = "right" if side == "left" else "left"
         lt, rt = self.left_type.copy(), self.right_type.copy()
         types = {"left": lt, "right": rt}
-        if types[side][i] in AUTO_TYPES:
+        if types[side][i] == "vector":       # Blender: a dragged vector handle is free
+            types[side][i] = "free"
+        elif types[side][i] in AUTO_TYPES:
             types[side][i] = "aligned"
-            if types[other][i] in AUTO_TYPES:
+            if types[other][i] in ("auto", "auto_clamped"):
                 types[other][i] = "aligned"
         pts = {"left": self.left.copy(), "right": self.right.copy()}
         key = np.array([self.times[i], self.values[i]])

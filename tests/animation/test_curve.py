@@ -100,6 +100,8 @@ def test_dragging_an_auto_handle_makes_both_aligned_and_collinear(curve):
     assert np.hypot(*d_left) == pytest.approx(np.hypot(*(curve.left[1] - key)))
     free = c.with_handle_type([1], "free").with_handle(1, "right", (1.2, 0.0))
     np.testing.assert_allclose(free.left[1], c.left[1])
+    vec = curve.with_handle_type([1], "vector").with_handle(1, "left", (0.8, 0.0))
+    assert vec.left_type[1] == "free" and vec.right_type[1] == "vector"
 
 
 def test_a_handle_cannot_cross_to_the_other_side_of_its_key(curve):
