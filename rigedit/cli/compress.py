@@ -79,47 +79,29 @@ def clip_names(rig, wanted):
 
 def compress_and_write(rig, names, output, args):
     """Compress the clips ``names`` of ``rig`` and write ``output``: compact glTF for
-    .glb/.gltf (the bound checked on the file as read, :mod:`rigedit.io.gltf_compress`),
-    rigedit's compressed clip file for its suffix, else a rig folder whose clips are the
-    glTF fit's reduced keys as read. Returns the report's lines."""
-    suffix = Path(output).suffix.lower()
+    .glb/.gltf (the bound checked on the file as read, :mod:`rigedit.io.gltf_compress`);
+    rigedit's own compressed clips (:mod:`rigedit.io.compressed_file`) for an .rgc file or a
+    rig folder (``animations/NAME.rgc`` beside the mesh and skeleton). Returns the report's
+    lines."""
     bound = dict(max_error=args.max_error_m, shell=args.shell_m)
-    if suffix in GLTF_SUFFIXES:
+    if Path(output).suffix.lower() in GLTF_SUFFIXES:
         from ..io.gltf_compress import save_gltf_compressed_rig
 
         report = save_gltf_compressed_rig(rig, output, names, meshopt=args.meshopt, **bound)
-    elif suffix == _own_suffix():
-        from ..compression import compress_clips
-        from ..io.compressed_file import save_compressed
+        return list(report.lines())
+    import dataclasses
 
-        result = compress_clips(rig.skeleton, {n: rig.clips[n] for n in names},
-                                target="rigedit", **bound)
-        save_compressed(output, result)
-        report = result.report
+    import rigedit
+    from ..compression import compress_clips
+    from ..io.compressed_file import SUFFIX, save_compressed
+
+    result = compress_clips(rig.skeleton, {n: rig.clips[n] for n in names}, target="rigedit",
+                            **bound)
+    if Path(output).suffix.lower() == SUFFIX:
+        save_compressed(output, rig.skeleton, result.clips)
     else:
-        import dataclasses
-
-        import rigedit
-        from ..io.gltf_compress import as_read, fit_clips
-
-        keys, report = fit_clips(rig.skeleton, {n: rig.clips[n] for n in names}, **bound)
-        rigedit.save_rig(dataclasses.replace(
-            rig.data(), clips={n: as_read(c) for n, c in keys.items()}), output)
-        for row in report.clips:   # sizes: the clip files as written (JSON text)
-            f = Path(output) / "animations" / f"{row.name}.json"
-            row.compressed_bytes = f.stat().st_size if f.is_file() else 0
-            row.bytes_by_kind = {"header": row.compressed_bytes}
-        return list(report.lines()) + ["sizes: the clips' JSON files in the rig folder"]
-    return list(report.lines())
-
-
-def _own_suffix():
-    """The suffix of rigedit's compressed clip file."""
-    try:
-        from ..io import compressed_file
-    except ImportError:   # not there yet: no output is one
-        return None
-    return compressed_file.SUFFIX
+        rigedit.save_rig(dataclasses.replace(rig.data(), clips=result.clips), output)
+    return list(result.report.lines())
 
 
 def add_parser(sub):

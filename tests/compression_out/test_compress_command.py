@@ -11,7 +11,7 @@ import pytest
 
 import rigedit
 from rigedit.cli.main import main
-from rigedit.compression import measure_error
+from rigedit.compression import CompressedClip, measure_error
 from rigedit.io.gltf_write_compact import meshopt_available
 
 from compact_helpers import validate
@@ -88,15 +88,28 @@ def test_meshopt_output_is_the_same_animation(tmp_path, rig):
 
 
 def test_compress_to_a_rig_folder(tmp_path, rig):
+    """A folder gets rigedit's own compressed clips beside its mesh and skeleton."""
     out = tmp_path / "folder"
     assert main(["compress", "humanoid", "--clip", "walk", "-o", str(out), "-q"]) == 0
+    assert (out / "animations" / "walk.rgc").is_file()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         back = rigedit.load_rig(out)
+    assert isinstance(back.clips["walk"], CompressedClip)
+    assert len(back.vertices) == len(rig.vertices)
     assert _worst(rig, back, ["walk"]) <= 1e-4
-    reduced = sum(len(t.times) for t in back.clips["walk"].tracks.values())
-    original = sum(len(t.times) for t in rig.clips["walk"].tracks.values())
-    assert reduced < original
+
+
+def test_compress_to_a_compressed_clip_file(tmp_path, capsys, rig):
+    out = tmp_path / "clips.rgc"
+    assert main(["compress", "humanoid", "--max-error", "0.02", "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    back = rigedit.load_rig(out)
+    assert set(back.clips) == set(rig.clips)
+    assert _worst(rig, back, rig.clips) <= 0.02 / 100
+    assert _report_max(printed) <= 0.02
+    raw = sum(40 * len(rig.skeleton) * len(rig.clips[n].key_times()) for n in rig.clips)
+    assert out.stat().st_size * 5 < raw
 
 
 def test_export_compress_writes_the_mesh_and_compressed_clips(tmp_path, capsys, rig):
