@@ -180,7 +180,8 @@ class Curve:
 
         A key is not passed over its neighbour: the move's time offset is clamped so every
         moved key stays more than :data:`MIN_GAP` from the unmoved keys (all moved keys by
-        the same clamped offset, so their order and spacing are kept).
+        the same clamped offset, so their order and spacing are kept), and no key goes before
+        time 0 (clips start there; their files refuse earlier keys).
         """
         idx = np.unique(np.asarray(indices, dtype=int).reshape(-1))
         if len(idx) == 0:
@@ -314,7 +315,8 @@ class Curve:
         left, right = self.left.copy(), self.right.copy()
         new_t = time_pivot + (times[idx] - time_pivot) * time_factor
         lo, hi = _bounds(self.times, idx)
-        new_t = np.clip(new_t, lo + MIN_GAP, hi - MIN_GAP)
+        new_t = np.clip(new_t, np.maximum(lo + MIN_GAP, np.minimum(times[idx], 0.0)),
+                        hi - MIN_GAP)
         new_t = np.maximum.accumulate(np.maximum(new_t, np.r_[-np.inf, new_t[:-1] + MIN_GAP]))
         for pts in (left, right):
             pts[idx, 0] = new_t + (pts[idx, 0] - times[idx]) * time_factor
@@ -366,7 +368,9 @@ def _bounds(times, idx):
 
 def _clamp_shift(times, idx, dt):
     """``dt`` clamped so the keys ``idx`` shifted by it stay between their unmoved
-    neighbours (:data:`MIN_GAP` apart)."""
+    neighbours (:data:`MIN_GAP` apart) and not before time 0 (a clip's start; a key already
+    before it does not move further back)."""
     lo, hi = _bounds(times, idx)
     t = times[idx]
-    return float(np.clip(dt, np.max(lo + MIN_GAP - t), np.min(hi - MIN_GAP - t)))
+    floor = np.maximum(lo + MIN_GAP, np.minimum(t, 0.0))   # clips start at 0
+    return float(np.clip(dt, np.max(floor - t), np.min(hi - MIN_GAP - t)))

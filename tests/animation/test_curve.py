@@ -118,6 +118,9 @@ def test_moved_keys_keep_their_handle_offsets_and_cannot_pass_a_neighbour(curve)
     both = curve.with_keys_moved([1, 2], 5.0, 0)    # moved together up to the next unmoved
     assert both.times[2] == pytest.approx(3 - MIN_GAP)
     assert both.times[2] - both.times[1] == pytest.approx(1.0)
+    early = curve.with_keys_moved([0, 1], -5.0, 0)   # not before a clip's start
+    np.testing.assert_allclose(early.times[:2], [0, 1])
+    assert curve.scaled([0, 1], 2.0, 3.0, 0, 1).times[0] == 0.0
 
 
 def test_insert_and_delete_keys(curve):
