@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 import pyvista as pv
-from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper, vtkRenderer, vtkTextActor
+from vtkmodules.vtkRenderingAnnotation import vtkScalarBarActor
+from vtkmodules.vtkRenderingCore import (vtkActor, vtkColorTransferFunction, vtkPolyDataMapper,
+                                         vtkRenderer, vtkTextActor)
 
 from .joint_glyphs import JointGlyphs
 from .overlay import OVERLAY_LAYER
@@ -30,7 +32,7 @@ RED = (0.95, 0.15, 0.12)
 #: The compressed skeleton's bones: pale, thin, so the coloured joints carry the meaning
 LINE_COLOR = (0.92, 0.92, 0.92)
 #: The joints' radius against the editor's joint spheres
-RADIUS_FRACTION = 0.45
+RADIUS_FRACTION = 0.6
 
 
 def error_colors(errors, bound):
@@ -86,6 +88,9 @@ class CompareOverlay:
         Metres: the error drawn red.
     radius : float
         The joints' spheres' radius (model units).
+    carriers : (J,) bool, optional
+        Carrier roots (:func:`rigedit.render.camera.figure_joints`): no line from them to
+        their children, as the editor's own bones.
 
     Attributes
     ----------
@@ -95,11 +100,16 @@ class CompareOverlay:
     glyphs : JointGlyphs
     text : vtkTextActor
         The figures (lower left): :meth:`set_text`.
+    legend : vtkScalarBarActor
+        The colours against the error in centimetres, 0 to the bound (above the text).
     """
 
-    def __init__(self, plotter, positions, parents, errors, bound, radius):
+    def __init__(self, plotter, positions, parents, errors, bound, radius, carriers=None):
         positions = np.asarray(positions, dtype=float).reshape(-1, 3)
         parents = np.asarray(parents).reshape(-1)
+        if carriers is not None:
+            carried = np.asarray(carriers, dtype=bool)[np.maximum(parents, 0)]
+            parents = np.where(carried, -1, parents)
         self.window = plotter.render_window
         self.renderer = renderer = vtkRenderer()
         renderer.SetLayer(COMPARE_LAYER)
@@ -132,10 +142,36 @@ class CompareOverlay:
         tp.SetColor(0.95, 0.95, 0.95)
         tp.SetBackgroundColor(0.1, 0.1, 0.12)
         tp.SetBackgroundOpacity(0.6)
-        self.actors = (self.line_actor, self.glyphs.actor, self.text)
+        self.legend = self._legend()
+        self.actors = (self.line_actor, self.glyphs.actor, self.text, self.legend)
         for actor in self.actors:
             renderer.AddActor(actor)
         self.update(positions, errors)
+
+    def _legend(self):
+        """A horizontal colour bar, 0 to the bound in centimetres, lower left."""
+        ramp = vtkColorTransferFunction()
+        cm = self.bound * 100
+        for at, rgb in ((0.0, GREEN), (0.5, YELLOW), (1.0, RED)):
+            ramp.AddRGBPoint(at * cm, *rgb)
+        bar = vtkScalarBarActor()
+        bar.SetLookupTable(ramp)
+        bar.SetOrientationToHorizontal()
+        bar.SetTitle("joint error (cm)")
+        bar.SetNumberOfLabels(3)
+        bar.SetLabelFormat("%.3g")
+        bar.GetPositionCoordinate().SetCoordinateSystemToDisplay()
+        bar.GetPositionCoordinate().SetValue(12, 44)
+        bar.SetMaximumWidthInPixels(260)
+        bar.SetMaximumHeightInPixels(60)
+        bar.SetWidth(0.3)
+        bar.SetHeight(0.08)
+        for tp in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty()):
+            tp.SetColor(0.95, 0.95, 0.95)
+            tp.SetFontSize(13)
+            tp.ItalicOff()
+            tp.ShadowOff()
+        return bar
 
     @property
     def colors(self):

@@ -153,11 +153,12 @@ class CompareCompressed:
         preview = self.preview
         positions, errors = preview.at(self.document.time)
         skeleton = preview.entry.compressed.skeleton
-        if self.overlay is None or len(self.overlay.positions) != len(skeleton):
+        if (self.overlay is None or len(self.overlay.positions) != len(skeleton)
+                or self.overlay.bound != preview.max_error):
             self._drop_overlay()
             self.overlay = CompareOverlay(self.view.plotter, positions, skeleton.parents,
-                                          errors, preview.max_error, self.view.radius)
-        self.overlay.bound = preview.max_error
+                                          errors, preview.max_error, self.view.radius,
+                                          self.view.scene.carriers)
         self.overlay.set_visible(self.document.mode == "pose")
         self._draw(positions, errors)
 
