@@ -268,10 +268,20 @@ def _view_uses(doc):
     return uses
 
 
+def _encoded(meshopt, data, mode, stride, count):
+    """One view's bytes through meshoptimizer's codec for ``mode``."""
+    if mode == "ATTRIBUTES":
+        rows = np.frombuffer(data, np.uint8).reshape(count, stride)
+    else:
+        rows = np.frombuffer(data, {2: "<u2", 4: "<u4"}[stride])
+    return meshopt.encode_gltf_buffer(rows, mode)
+
+
 def meshopt_buffers(w):
     """Move the writer's views into ``EXT_meshopt_compression``: buffer 0 (the GLB's BIN chunk
-    or the data URI) holds the compressed views and the ones left as they are; buffer 1 is the
-    extension's fallback buffer (no data: the extension is required)."""
+    or the data URI) holds the compressed views and the ones left as they are (images, views
+    meshopt cannot take or does not make smaller); buffer 1 is the extension's fallback buffer
+    (no data: the extension is required)."""
     import meshopt
 
     doc, old = w.doc, bytes(w.blob)
@@ -280,17 +290,12 @@ def meshopt_buffers(w):
     for v, view in enumerate(doc["bufferViews"]):
         data = old[view["byteOffset"]:view["byteOffset"] + view["byteLength"]]
         blob += bytes((-len(blob)) % 4)
-        if v not in uses:
+        packed = _encoded(meshopt, data, *uses[v]) if v in uses else None
+        if packed is None or len(packed) >= len(data):   # a tiny view: no gain
             view["byteOffset"] = len(blob)
             blob += data
             continue
         mode, stride, count = uses[v]
-        dtype = {1: "u1", 2: "<u2", 4: "<u4"}.get(stride, "u1")
-        if mode == "ATTRIBUTES":
-            rows = np.frombuffer(data, np.uint8).reshape(count, stride)
-        else:
-            rows = np.frombuffer(data, dtype)
-        packed = meshopt.encode_gltf_buffer(rows, mode)
         ext = {"buffer": 0, "byteOffset": len(blob), "byteLength": len(packed),
                "byteStride": stride, "count": count, "mode": mode}
         blob += packed
