@@ -58,7 +58,8 @@ class ChannelList(QtWidgets.QListWidget):
                 flags &= ~QtCore.Qt.ItemIsEnabled
                 item.setToolTip(f"{c.label}: no keys in this clip")
             item.setFlags(flags)
-            item.setCheckState(QtCore.Qt.Unchecked if c.id in self.hidden
+            # a channel without keys draws nothing: unticked, but not hidden (keyed, it shows)
+            item.setCheckState(QtCore.Qt.Unchecked if c.id in self.hidden or c.curve is None
                                else QtCore.Qt.Checked)
             item.setData(_ID_ROLE, len(self._ids))
             self._ids.append(c.id)

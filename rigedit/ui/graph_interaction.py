@@ -28,7 +28,7 @@ click the ruler        set the time cursor (drag to scrub)
 from __future__ import annotations
 
 import numpy as np
-from PyQt5 import QtCore, QtGui
+from PyQt5 import QtCore
 
 from ..editor.playback import snap_to_frame
 
@@ -67,6 +67,10 @@ class GraphInteraction(QtCore.QObject):
         self.view, self.document, self.commands = view, document, commands
         self.fps, self.set_time, self.status = fps, set_time, status
         self._gesture = None
+        self._mouse = QtCore.QPoint(view.width() // 2, view.height() // 2)
+        # moves without a button tell where the mouse is (S scales from there); no gesture,
+        # no work beyond that
+        view.setMouseTracking(True)
         view.installEventFilter(self)
 
     @property
@@ -89,6 +93,8 @@ class GraphInteraction(QtCore.QObject):
                    QtCore.QEvent.KeyPress: self._key}.get(t)
         if handler is None:
             return False
+        if t != QtCore.QEvent.KeyPress:
+            self._mouse = event.pos()
         return bool(handler(event))
 
     def _press(self, e):
@@ -210,7 +216,6 @@ class GraphInteraction(QtCore.QObject):
     def _end(self, cancel=False):
         """Finish (or cancel) the gesture in progress."""
         g, self._gesture = self._gesture, None
-        self.view.setMouseTracking(False)
         self.view.rubber_band = None
         drag = getattr(g, "drag", None)
         if drag is not None:
@@ -303,9 +308,7 @@ class GraphInteraction(QtCore.QObject):
         if not self.selection():
             self.status("Graph editor: select keys to scale")
             return
-        pos = self.view.mapFromGlobal(QtGui.QCursor.pos())
-        self._gesture = _Scale(self, pos)
-        self.view.setMouseTracking(True)
+        self._gesture = _Scale(self, self._mouse)
         self.status("Scale: move the mouse; click or Enter to finish, Esc to cancel")
 
     def scale_selected(self, time_factor, value_factor=1.0):

@@ -105,7 +105,6 @@ class GraphView(QtWidgets.QWidget):
         self._background = None
         self.setMinimumSize(240, 120)
         self.setFocusPolicy(QtCore.Qt.StrongFocus)
-        self.setMouseTracking(False)
 
     # ------------------------------------------------------------------ state
     def visible_channels(self):
@@ -152,15 +151,18 @@ class GraphView(QtWidgets.QWidget):
                     [cv.values for cv in curves])
 
     def frame_selected(self):
-        """Fit the selected keys (with their handles); all keys when none is selected."""
+        """Fit the selected keys with their drawn handles; all keys when none is selected."""
         times, values = [], []
         for c in self.visible_channels():
             idx = self.selected.get(c.id)
             if idx is None or not len(idx):
                 continue
-            cv = c.curve
-            times += [cv.times[idx], cv.left[idx, 0], cv.right[idx, 0]]
-            values += [cv.values[idx], cv.left[idx, 1], cv.right[idx, 1]]
+            times.append(c.curve.times[idx])
+            values.append(c.curve.values[idx])
+            sides = self.handle_sides(c)
+            if sides is not None:
+                times.append(sides[1][:, 0])
+                values.append(sides[1][:, 1])
         if not times:
             self.frame_all()
             return

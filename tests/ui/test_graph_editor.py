@@ -303,3 +303,64 @@ def test_the_walk_draws_and_the_view_menu_shows_the_dock(window):
     assert {c.id.channel for c in shown} == {"translation", "rotation"}
     assert all(len(c.curve.times) == len(d.clip.tracks[(JOINT, c.id.channel)].times)
                for c in shown)
+
+
+def _click_button(window, text):
+    from PyQt5 import QtWidgets as W
+    b = next(b for b in window.graph_editor.dock.findChildren(W.QToolButton) if b.text() == text)
+    QTest.mouseClick(b, QtCore.Qt.LeftButton)
+
+
+def test_s_scales_the_selected_keys_about_the_time_cursor(window):
+    d, view = window.document, _only(window, T_Y)
+    d.set_time(0.0)
+    QTest.mouseClick(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, _key_pos(view, T_Y, 1))
+    tr = view.transform
+    x0, x_key = float(tr.x_of(0.0)), _key_pos(view, T_Y, 1).x()
+    QTest.keyClick(view, QtCore.Qt.Key_S)
+    # the mouse at 1.5 times the key's distance from the cursor: the key's time x1.5
+    target = QtCore.QPoint(int(round(x0 + 1.5 * (x_key - x0))), _key_pos(view, T_Y, 1).y())
+    e = QtGui.QMouseEvent(QtCore.QEvent.MouseMove, QtCore.QPointF(target), QtCore.Qt.NoButton,
+                          QtCore.Qt.NoButton, QtCore.Qt.NoModifier)
+    QtWidgets.QApplication.sendEvent(view, e)
+    QTest.mouseClick(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, target)
+    cv = _channel(view, T_Y).curve
+    assert cv.times.tolist() == pytest.approx([0.0, 0.45, 0.6, 1.0])
+    assert d.undo_stack.undo_label == "Scale keys"
+    assert _height(window, 0.45) == pytest.approx(_height(window, 0.0) + 0.2)
+    # Esc cancels a scale: nothing changes
+    QTest.keyClick(view, QtCore.Qt.Key_S)
+    QtWidgets.QApplication.sendEvent(view, QtGui.QMouseEvent(
+        QtCore.QEvent.MouseMove, QtCore.QPointF(target + QtCore.QPoint(40, 0)),
+        QtCore.Qt.NoButton, QtCore.Qt.NoButton, QtCore.Qt.NoModifier))
+    QTest.keyClick(view, QtCore.Qt.Key_Escape)
+    assert _channel(view, T_Y).curve.times.tolist() == pytest.approx([0.0, 0.45, 0.6, 1.0])
+    assert d.undo_stack.undo_label == "Scale keys"
+
+
+def test_the_tool_row_sets_interpolation_and_easing_on_the_selected_key(window):
+    view = _only(window, T_Y)
+    QTest.mouseClick(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, _key_pos(view, T_Y, 1))
+    h1, h2 = _height(window, 0.3), _height(window, 0.6)
+    linear_at = h1 + (h2 - h1) * 0.1            # a tenth into the segment 0.3 -> 0.6
+    _click_button(window, "Ease out")           # the curve leaves key 1 flat
+    eased = _height(window, 0.33)
+    assert abs(eased - h1) < 0.5 * abs(linear_at - h1)
+    assert _channel(view, T_Y).curve.interpolation[1] == "bezier"
+    _click_button(window, "Constant")           # holds key 1's value until key 2
+    assert _height(window, 0.59) == pytest.approx(h1)
+    assert _height(window, 0.6) == pytest.approx(h2)
+    window.undo()
+    assert _height(window, 0.33) == pytest.approx(eased)
+
+
+def test_frame_selected_fits_the_selected_keys(window):
+    view = _only(window, T_Y)
+    QTest.mouseClick(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, _key_pos(view, T_Y, 2))
+    QTest.keyClick(view, QtCore.Qt.Key_F)
+    tr = view.transform
+    assert tr.t0 < 0.6 < tr.t1 and tr.t1 - tr.t0 < 1.5   # one key: about a second, around it
+    x = float(tr.x_of(0.6))
+    assert abs(x - (tr.left + tr.width / 2)) < 2
+    QTest.keyClick(view, QtCore.Qt.Key_Home)
+    assert tr.t0 <= 0.0 and tr.t1 >= 1.0
