@@ -6,14 +6,14 @@ Conversion (:func:`curves_from_track`), per mode of the track:
 =========================================  ===============================================
 ``step``                                   ``constant`` keys
 ``linear``                                 ``linear`` keys (exact)
-``nlerp``, ``slerp``, ``hybrid``           ``bezier`` keys whose ``free`` handles follow the
+``nlerp``, ``slerp``, ``hybrid``           ``bezier`` keys whose handles follow the
 (rotations)                                track's Euler velocity on each side of the key
                                            (a finite difference): Euler angles running
                                            linearly between keys would leave the arc slerp
                                            takes (9 degrees off mid-segment on keys 25 to
                                            123 degrees apart; these handles: under 1 for
                                            slerp, under 2 for nlerp)
-``catmull_rom``, ``cubic_spline``          ``bezier`` keys with ``free`` handles a third of
+``catmull_rom``, ``cubic_spline``          ``bezier`` keys with handles a third of
                                            each segment long: exact for vectors (a cubic
                                            Hermite is that Bezier); for a rotation the
                                            handles follow the Euler velocity as above (a
@@ -22,8 +22,11 @@ Conversion (:func:`curves_from_track`), per mode of the track:
                                            mid-segment on the same keys)
 =========================================  ===============================================
 
-Rotations become Euler angles per key in degrees (:func:`~.euler_curves.quat_to_euler`,
-unwrapped so the curves stay continuous across +-180 degrees).
+Converted handles are ``aligned`` where the key's velocity is the same on both sides (a
+dragged handle then keeps the key smooth), ``free`` where it is not (a slerp's keys, a
+cubic_spline's own in- and out-tangents). Rotations become Euler angles per key in degrees
+(:func:`~.euler_curves.quat_to_euler`, unwrapped so the curves stay continuous across +-180
+degrees).
 """
 from __future__ import annotations
 
@@ -86,7 +89,10 @@ def curves_from_track(track, euler_order=DEFAULT_ORDER):
         v = values[:, a]
         left = np.stack([times - before, v - slopes[:, 0, a] * before], axis=1)
         right = np.stack([times + after, v + slopes[:, 1, a] * after], axis=1)
-        curves.append(Curve(times, v, "bezier", left, right, "free", "free"))
+        # a smooth key (the same velocity on both sides) keeps its handles collinear
+        smooth = np.isclose(slopes[:, 0, a], slopes[:, 1, a], rtol=1e-6, atol=1e-9)
+        kind = np.where(smooth, "aligned", "free").astype(object)
+        curves.append(Curve(times, v, "bezier", left, right, kind, kind))
     return tuple(curves)
 
 

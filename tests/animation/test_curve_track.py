@@ -39,10 +39,15 @@ def test_a_spin_about_z_keeps_counting():
 @pytest.mark.parametrize("mode", ["step", "linear", "catmull_rom", "cubic_spline"])
 def test_vector_tracks_convert_exactly(mode):
     rng = np.random.default_rng(2)
-    track = Track("translation", TIMES, rng.normal(size=(9, 3)), mode)
+    tangents = rng.normal(size=(9, 2, 3)) if mode == "cubic_spline" else None
+    track = Track("translation", TIMES, rng.normal(size=(9, 3)), mode, tangents)
     bezier = Track.from_curves("translation", curves_from_track(track))
     for t in np.linspace(-0.5, 2.5, 97):
         np.testing.assert_allclose(bezier.sample(t), track.sample(t), atol=1e-9)
+    if mode == "catmull_rom":   # C1 keys: handles aligned; glTF's own tangents: free
+        assert set(bezier.curves[0].left_type) == {"aligned"}
+    if mode == "cubic_spline":
+        assert "free" in set(bezier.curves[0].left_type)
 
 
 def test_rotation_tracks_convert_through_the_keys():

@@ -118,7 +118,7 @@ def test_insert_delete_and_per_key_settings(doc):
         doc.redo()
         np.testing.assert_allclose([euler_z(doc, t) for t in (0.1, 0.2, 0.3, 0.6)], state,
                                    atol=1e-9)
-    assert len(view(doc, RZ).curve) == 3 and view(doc, RZ).curve.left_type[2] == "free"
+    assert len(view(doc, RZ).curve) == 3 and view(doc, RZ).curve.left_type[1] == "free"
 
 
 def test_deleting_every_key_of_a_channel_removes_its_track(doc):
