@@ -171,6 +171,14 @@ class GraphEditor:
 
     # ================================================================== document events
     def _on_event(self, event):
+        i = self.interaction
+        if i.busy:
+            # a drag's step is recorded after its gesture ends: an undo step or a new rig
+            # meanwhile came from elsewhere (Ctrl+Z during a drag)
+            if isinstance(event, (ev.UndoChanged, ev.RigReplaced)):
+                i.abandon()
+            elif type(event) is ev.ClipChanged:   # another clip chosen (not KeysChanged)
+                i.interrupt()
         if isinstance(event, ev.TimeChanged):
             self.view.set_time(event.time)
         elif isinstance(event, (ev.ClipChanged, ev.SelectionChanged, ev.RigReplaced)):

@@ -222,6 +222,19 @@ class GraphInteraction(QtCore.QObject):
             drag.cancel() if cancel else drag.finish()
         self.view.update()
 
+    def abandon(self):
+        """Drop the gesture in progress without touching the clip: something else changed
+        it (an undo or redo, another rig), so the drag's picture of it is stale."""
+        self._gesture = None
+        self.view.rubber_band = None
+        self.view.update()
+
+    def interrupt(self):
+        """The current clip is no longer the one being dragged: end the gesture (a drag of
+        the old clip is put back as it was, with no undo step)."""
+        if self._gesture is not None:
+            self._end()
+
     def _scrub(self, pos):
         t = float(self.view.transform.t_of(pos.x()))
         self.set_time(snap_to_frame(max(t, 0.0), self.fps()))

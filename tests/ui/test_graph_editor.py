@@ -364,3 +364,23 @@ def test_frame_selected_fits_the_selected_keys(window):
     assert abs(x - (tr.left + tr.width / 2)) < 2
     QTest.keyClick(view, QtCore.Qt.Key_Home)
     assert tr.t0 <= 0.0 and tr.t1 >= 1.0
+
+
+def test_an_undo_during_a_drag_ends_the_drag_without_an_edit(window):
+    d, view = window.document, _only(window, T_Y)
+    QTest.mouseClick(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, _key_pos(view, T_Y, 2))
+    QTest.keyClick(view, QtCore.Qt.Key_Delete)          # an edit to undo
+    start = _key_pos(view, T_Y, 1)
+    QTest.mousePress(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
+    _move(view, start + QtCore.QPoint(0, -30))
+    assert window.graph_editor.interaction.busy
+    window.undo()                                        # Ctrl+Z while the mouse is held
+    assert not window.graph_editor.interaction.busy
+    _move(view, start + QtCore.QPoint(0, -60))
+    QTest.mouseRelease(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier,
+                       start + QtCore.QPoint(0, -60))
+    # the undo's state stands: four keys, as the clip was made, and Redo redoes the delete
+    assert _channel(view, T_Y).curve.times.tolist() == pytest.approx(KEY_TIMES)
+    rest_y = d.skeleton.rest_translation[d.skeleton.index[JOINT], 1]
+    assert _height(window, 0.3) == pytest.approx(rest_y + 0.2)
+    assert d.undo_stack.redo_label.startswith("Delete")
