@@ -14,32 +14,21 @@ import numpy as np
 
 from .bits import read_fields, words_of
 from .frames import COLUMNS
+from .kernels import load, loaded
 from .quantise import OTHERS, PER_KEY
 
 __all__ = ["ClipDecoder", "kernels", "kernels_loaded"]
 
-_KERNELS = []
-
-
 def kernels_loaded():
     """True once :func:`kernels` has imported the compiled kernels."""
-    return bool(_KERNELS) and _KERNELS[0] is not None
+    return loaded("codec_kernels")
 
 
 def kernels():
     """The compiled decode kernels (:mod:`.codec_kernels`), imported and compiled (or loaded
     from numba's disk cache) on the first call; None when numba is missing or
     ``RIGEDIT_NO_NUMBA=1``."""
-    if not _KERNELS:
-        import os
-        module = None
-        if os.environ.get("RIGEDIT_NO_NUMBA", "") in ("", "0"):
-            try:
-                from . import codec_kernels as module
-            except ImportError:
-                module = None
-        _KERNELS.append(module)
-    return _KERNELS[0]
+    return load("codec_kernels")
 
 
 class ClipDecoder:

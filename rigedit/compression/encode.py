@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .constant import ANIMATED, CONSTANT, OMITTED, classify
+from .constant import ANIMATED, CONSTANT, classify
 from .layout import EncodedTrack
 from .quantise import VectorCode, quantise_rotations, quantise_vectors, rotation_from_three
 from .reduce import reduce_keys
 
-__all__ = ["QUANTISE_SHARE", "encode_track", "gltf_track"]
+__all__ = ["QUANTISE_SHARE", "encode_tracks", "gltf_tracks", "gltf_values"]
 
 #: Part of a track's tolerance its quantisation may take; key reduction gets the rest (it
 #: measures the quantised values, so the two together stay within the tolerance). One bit
@@ -25,45 +25,63 @@ def _classified(values, rest, tol, rotation):
     return kind, value
 
 
-def encode_track(joint, channel, values, rest, tol, grid):
-    """The stored form of one track for rigedit's format.
+def _reduce_groups(grid, animated):
+    """Reduce the keys of many tracks at once, one :func:`reduce_keys` call per kind
+    (rotations, vectors). ``animated``: list of (values (F, C), decoded (F, C), tol,
+    rotation); returns the kept frame indices of each."""
+    keys = [None] * len(animated)
+    for rotation in (True, False):
+        group = [i for i, a in enumerate(animated) if a[3] == rotation]
+        if not group:
+            continue
+        keep = reduce_keys(grid, np.stack([animated[i][0] for i in group]),
+                           np.stack([animated[i][1] for i in group]),
+                           np.array([animated[i][2] for i in group]), rotation)
+        for row, i in zip(keep, group):
+            keys[i] = np.flatnonzero(row)
+    return keys
+
+
+def encode_tracks(items, grid):
+    """The stored form of tracks of one clip for rigedit's format, all reduced together.
 
     Parameters
     ----------
-    joint : int
-    channel : str
-    values : (F, C) float64
-        The track at every frame.
-    rest : (C,) float64
-    tol : float
-        In the channel's units (quaternion distance for rotations).
+    items : list of (joint, channel, values (F, C), rest (C,), tol)
+        Each track at every frame, its joint's rest value and its tolerance in the channel's
+        units (quaternion distance for rotations).
     grid : (F,) float64
         The frame times as decoded.
 
     Returns
     -------
-    EncodedTrack or None
+    list of EncodedTrack or None
         None: the track is the rest value (not stored).
     """
-    rotation = channel == "rotation"
-    kind, value = _classified(values, rest, tol, rotation)
-    if kind == OMITTED:
-        return None
-    if kind == CONSTANT:
-        return EncodedTrack(joint, channel, value=value)
-    quant = QUANTISE_SHARE * tol
-    if rotation:
-        mode, code, dropped = quantise_rotations(values, quant)
-        decoded = rotation_from_three(code.values(), dropped)
-    else:
-        mode, dropped = 0, None
-        code = quantise_vectors(values, 2 * quant / np.sqrt(3))
-        decoded = code.values()
-    keep = reduce_keys(grid, values[None], decoded[None], np.array([tol]), rotation)[0]
-    keys = np.flatnonzero(keep)
-    return EncodedTrack(joint, channel, keys=keys, mode=mode,
-                        code=VectorCode(code.lo, code.ext, code.bits, code.codes[keys]),
-                        dropped=None if dropped is None else dropped[keys])
+    out, animated, codes = [None] * len(items), [], []
+    for i, (joint, channel, values, rest, tol) in enumerate(items):
+        rotation = channel == "rotation"
+        kind, value = _classified(values, rest, tol, rotation)
+        if kind == CONSTANT:
+            out[i] = EncodedTrack(joint, channel, value=value)
+        if kind != ANIMATED:
+            continue
+        quant = QUANTISE_SHARE * tol
+        if rotation:
+            mode, code, dropped = quantise_rotations(values, quant)
+            decoded = rotation_from_three(code.values(), dropped)
+        else:
+            mode, dropped = 0, None
+            code = quantise_vectors(values, 2 * quant / np.sqrt(3))
+            decoded = code.values()
+        animated.append((values, decoded, tol, rotation))
+        codes.append((i, mode, code, dropped))
+    for keys, (i, mode, code, dropped) in zip(_reduce_groups(grid, animated), codes):
+        joint, channel = items[i][:2]
+        out[i] = EncodedTrack(joint, channel, keys=keys, mode=mode,
+                              code=VectorCode(code.lo, code.ext, code.bits, code.codes[keys]),
+                              dropped=None if dropped is None else dropped[keys])
+    return out
 
 
 def gltf_values(values, rotation):
@@ -77,16 +95,23 @@ def gltf_values(values, rotation):
     return np.round(q * 32767.0) / 32767.0
 
 
-def gltf_track(channel, values, rest, tol, grid):
-    """The reduced keys of one track for glTF: ``(times (K,), values (K, C))`` (float32
-    times, values as :func:`gltf_values`), or ``("constant", value)``, or None (the rest)."""
-    rotation = channel == "rotation"
-    kind, value = _classified(values, rest, tol, rotation)
-    if kind == OMITTED:
-        return None
-    stored = gltf_values(values, rotation)
-    if kind == CONSTANT:
-        return grid[:1], gltf_values(value[None].astype(np.float64), rotation)
-    decoded = stored / np.linalg.norm(stored, axis=1, keepdims=True) if rotation else stored
-    keep = reduce_keys(grid, values[None], decoded[None], np.array([tol]), rotation)[0]
-    return grid[keep], stored[keep]
+def gltf_tracks(items, grid):
+    """The reduced keys of tracks for glTF, items as :func:`encode_tracks`: each
+    ``(times (K,), values (K, C))`` (float32 times, values as :func:`gltf_values`; one key for
+    a constant track), or None (the rest)."""
+    out, animated, stored_all = [None] * len(items), [], []
+    for i, (joint, channel, values, rest, tol) in enumerate(items):
+        rotation = channel == "rotation"
+        kind, value = _classified(values, rest, tol, rotation)
+        if kind == CONSTANT:
+            out[i] = grid[:1], gltf_values(value[None].astype(np.float64), rotation)
+        if kind != ANIMATED:
+            continue
+        stored = gltf_values(values, rotation)
+        decoded = stored / np.linalg.norm(stored, axis=1, keepdims=True) if rotation \
+            else stored
+        animated.append((values, decoded, tol, rotation))
+        stored_all.append((i, stored))
+    for keys, (i, stored) in zip(_reduce_groups(grid, animated), stored_all):
+        out[i] = grid[keys], stored[keys]
+    return out

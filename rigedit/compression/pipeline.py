@@ -20,7 +20,7 @@ from ..model.pose import Pose
 from ..progress import adapt
 from .budget import Budget
 from .compressed_clip import CompressedClip, KeyedClip
-from .encode import encode_track, gltf_track
+from .encode import encode_tracks, gltf_tracks
 from .error import ErrorMeter
 from .frames import COLUMNS, frame_times
 from .layout import ClipLayout, grid_times, write_clip
@@ -104,18 +104,13 @@ def _compress_one(skeleton, clip, max_error, distances, target, shell, mesh):
     sources = [(skeleton.index[name], channel) for name, channel in clip.tracks]
     cache = {}
     for attempt in range(1, MAX_ATTEMPTS + 1):
-        stored = {}
-        for j, channel in sources:
-            tol = budget.tolerance(j, channel)
-            hit = cache.get((j, channel))
-            if hit is None or hit[0] != tol:
-                cols = COLUMNS[channel]
-                encode = encode_track if target == "rigedit" else gltf_track
-                args = (ref[:, j, cols], rest[j, cols], tol, grid)
-                hit = cache[(j, channel)] = (tol, encode(j, channel, *args) if
-                                             target == "rigedit" else encode(channel, *args))
-            if hit[1] is not None:
-                stored[(j, channel)] = hit[1]
+        tols = {(j, c): budget.tolerance(j, c) for j, c in sources}
+        todo = [(j, c) for j, c in sources if cache.get((j, c), (None,))[0] != tols[(j, c)]]
+        encode = encode_tracks if target == "rigedit" else gltf_tracks
+        done = encode([(j, c, ref[:, j, COLUMNS[c]], rest[j, COLUMNS[c]], tols[(j, c)])
+                       for j, c in todo], grid)
+        cache.update({key: (tols[key], enc) for key, enc in zip(todo, done)})
+        stored = {key: cache[key][1] for key in sources if cache[key][1] is not None}
         compressed = (_rigedit_clip if target == "rigedit" else _gltf_clip)(
             skeleton, clip, stored, uniform, grid)
         err = meter.error(compressed)

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .kernels import load
+
 __all__ = ["interpolate_kept", "reduce_keys"]
 
 
@@ -49,7 +51,7 @@ def _error(interp, reference, rotation):
     return d
 
 
-def reduce_keys(times, reference, values, tol, rotation):
+def reduce_keys(times, reference, values, tol, rotation, compiled=True):
     """Which frames to keep as keys so every frame is within ``tol`` of the reference.
 
     Parameters
@@ -62,6 +64,8 @@ def reduce_keys(times, reference, values, tol, rotation):
     tol : (T,) float64
         Per track, in the channel's units (quaternion distance for rotations).
     rotation : bool
+    compiled : bool
+        Run the compiled kernel (:mod:`.reduce_kernels`) where numba is there: the same keys.
 
     Returns
     -------
@@ -74,6 +78,13 @@ def reduce_keys(times, reference, values, tol, rotation):
     keep[:, 0] = keep[:, -1] = True
     if f <= 2:
         keep[:] = True
+        return keep
+    kernels = load("reduce_kernels") if compiled else None
+    if kernels is not None:
+        kernels.reduce_many(np.ascontiguousarray(times, dtype=np.float64),
+                            np.ascontiguousarray(reference, dtype=np.float64),
+                            np.ascontiguousarray(values, dtype=np.float64),
+                            np.asarray(tol, dtype=np.float64).reshape(-1), bool(rotation), keep)
         return keep
     tol = np.asarray(tol, dtype=np.float64)[:, None]
     flat = keep.reshape(-1)

@@ -49,3 +49,24 @@ def test_truncated_blob_is_one_layout_error(packed, cut):
 def test_joint_beyond_the_skeleton_is_refused(packed):
     with pytest.raises(LayoutError, match="joint index"):
         read_clip(packed.blob, 3)
+
+
+def test_compiled_reduction_keeps_the_same_keys():
+    from rigedit.compression.kernels import load
+    from rigedit.compression.reduce import reduce_keys
+    from compression_characters import smooth_rotations
+
+    if load("reduce_kernels") is None:
+        pytest.skip("numba is not installed or RIGEDIT_NO_NUMBA is set")
+    times = np.arange(200) / 120.0
+    ref = np.stack([smooth_rotations(200, rate=120.0, amplitude=0.2, seed=s) for s in range(5)])
+    noisy = ref + np.random.default_rng(2).normal(0, 1e-5, ref.shape)
+    tol = np.array([1e-4, 3e-4, 1e-3, 1e-5, 2e-3])
+    slow = reduce_keys(times, ref, noisy, tol, True, compiled=False)
+    fast = reduce_keys(times, ref, noisy, tol, True)
+    assert np.array_equal(slow, fast)
+    vec = ref[..., :3] * 2
+    assert np.array_equal(reduce_keys(times, vec, vec, tol, False, compiled=False),
+                          reduce_keys(times, vec, vec, tol, False))
+    kept = slow.sum(axis=1)
+    assert kept[2] < 100 and kept[4] < 100 and kept[3] > kept[0] > kept[1] > kept[2]
