@@ -135,12 +135,16 @@ def rigedit_rows(ref, source, tmp, rows):
     for label, max_error in RIGEDIT_RUNS:
         for meshopt in (False, True):
             out = tmp / f"{source.stem}_{max_error:g}{'_meshopt' if meshopt else ''}.glb"
+            label_m = label + (" meshopt" if meshopt else "")
             t0 = time.perf_counter()
-            report = save_gltf_compressed_rig(rig, out, max_error=max_error, shell=SHELL,
-                                              meshopt=meshopt)
+            try:
+                report = save_gltf_compressed_rig(rig, out, max_error=max_error, shell=SHELL,
+                                                  meshopt=meshopt)
+            except RigFileError as exc:   # a bound the compressor cannot reach
+                rows.append((f"{label_m}: FAILED: {str(exc).split(': ', 1)[-1]}",))
+                continue
             dt = time.perf_counter() - t0
-            rows.append((label + (" meshopt" if meshopt else ""), *measure_gltf(ref, out), dt,
-                         report.max_error))
+            rows.append((label_m, *measure_gltf(ref, out), dt, report.max_error))
     own_format_row(ref, rig, rows)
 
 
@@ -150,17 +154,21 @@ def own_format_row(ref, rig, rows):
     from rigedit.compression import compress_clips
 
     for max_error in (1e-4, 5e-4):
+        label = f"rigedit own format {max_error * 100:g} cm"
         t0 = time.perf_counter()
-        result = compress_clips(rig.skeleton, rig.clips, max_error=max_error, shell=SHELL,
-                                target="rigedit")
+        try:
+            result = compress_clips(rig.skeleton, rig.clips, max_error=max_error, shell=SHELL,
+                                    target="rigedit")
+        except ValueError as exc:
+            rows.append((f"{label}: FAILED: {exc}",))
+            continue
         dt = time.perf_counter() - t0
         cols = _joint_columns(ref, rig.skeleton)
         frames = {name: skeleton_world(rig.skeleton.parents,
                                        clip.sample_many(ref.times[name]))[:, cols]
                   for name, clip in result.clips.items()}
         e = ref.errors(lambda a, t: frames[a])
-        rows.append((f"rigedit own format {max_error * 100:g} cm",
-                     ref.raw / result.report.compressed_bytes, float(e.max()),
+        rows.append((label, ref.raw / result.report.compressed_bytes, float(e.max()),
                      float(np.percentile(e, 99)), dt, float(result.report.max_error)))
 
 
@@ -246,12 +254,13 @@ def main(argv=None):
         if not ref.times:
             continue
         rows = []
-        try:
-            rigedit_rows(ref, source, tmp, rows)
-        except (ValueError, RigFileError) as exc:   # a bound the compressor cannot reach
-            print(f"{Path(rel).name:<40} rigedit: FAILED: {exc}")
+        rigedit_rows(ref, source, tmp, rows)
         tool_rows(ref, source, tmp, args.tools, rows)
-        for label, ratio, emax, p99, dt, said in rows:
+        for row in rows:
+            if len(row) == 1:
+                print(f"{Path(rel).name:<40} {row[0]}")
+                continue
+            label, ratio, emax, p99, dt, said = row
             said = "" if said is None else f"{said * 100:.4f}"
             print(f"{Path(rel).name:<40} {label:<28} {ratio:7.1f} {emax * 100:8.4f} "
                   f"{p99 * 100:8.4f} {dt:7.2f} {said:>13}")
