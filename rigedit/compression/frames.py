@@ -125,7 +125,7 @@ def sample_track_many(track, times):
         return np.repeat(value[None], len(times), axis=0)
     mode = track.interpolation
     if mode in ("catmull_rom", "cubic_spline", "bezier"):   # bezier: curves between keys
-        return np.array([track.sample(float(t)) for t in times])
+        return track.sample_many(times)   # one vectorised call (bezier: its curves)
     i = np.clip(np.searchsorted(kt, times, side="right") - 1, 0, len(kt) - 2)
     a, b = kv[i], kv[i + 1]
     if mode == "step":
