@@ -16,7 +16,8 @@ decoder on its first sample, ~1 s, once per process).
 
 Prints, per clip, the median and best milliseconds per step over ``--rounds`` rounds of
 ``--frames`` frames, the sampling alone (``clip.sample``) per clip, and the ratios
-compressed / original. Run under a display or with OSMesa:
+compressed / original; and the original's step with View > Compare compressed on (the
+preview's ``at(t)`` and the overlay's update and text each frame), against it off. Run under a display or with OSMesa:
 ``xvfb-run -a .venv/bin/python benchmarks/bench_compressed_playback.py``.
 """
 from __future__ import annotations
@@ -54,14 +55,34 @@ def setup(rig_name, clip_name, max_error_cm):
     return doc, scene, plotter, {"original": clip_name, "compressed": compressed_name}, report
 
 
-def step_loop(doc, scene, plotter, times):
-    """Seconds per playback step over ``times``."""
+def step_loop(doc, scene, plotter, times, compare=None):
+    """Seconds per playback step over ``times`` (``compare``: (preview, overlay) drawn too,
+    as View > Compare compressed does on each time change)."""
     start = time.perf_counter()
     for t in times:
         doc.set_time(t)
         scene.update_from_matrices(doc.rig.joint_matrices(doc.pose))
+        if compare is not None:
+            preview, overlay = compare
+            positions, errors = preview.at(t)
+            overlay.update(positions, errors)
+            overlay.set_text(preview.summary(errors))
         plotter.render()
     return (time.perf_counter() - start) / len(times)
+
+
+def comparison(doc, scene, plotter, name, max_error):
+    """View > Compare compressed's preview of clip ``name`` and its overlay."""
+    from rigedit.editor.compression import CompressedPreview
+    from rigedit.render.compare_overlay import CompareOverlay
+
+    doc.set_current_clip(name)
+    preview = CompressedPreview(doc, max_error)
+    preview.refresh()
+    positions, errors = preview.at(0.0)
+    overlay = CompareOverlay(plotter, positions, doc.skeleton.parents, errors, max_error,
+                             0.02, scene.carriers)
+    return preview, overlay
 
 
 def sample_loop(clip, pose, times):
@@ -85,30 +106,39 @@ def main(argv=None):
     rig = doc.rig
     duration = rig.clips[names["original"]].duration
     times = (np.arange(args.frames) / 30.0) % max(duration, 1e-6)
-    steps = {k: [] for k in names}
+    steps = {k: [] for k in (*names, "compare")}
     samples = {k: [] for k in names}
     pose = rig.rest_pose()
     for name in names.values():   # warm-up: decoders, kernels, the first renders
         doc.set_current_clip(name)
         step_loop(doc, scene, plotter, times[:10])
+    compare = comparison(doc, scene, plotter, names["original"], args.max_error / 100)
     for _ in range(args.rounds):
         for kind, name in names.items():
             doc.set_current_clip(name)
             steps[kind].append(step_loop(doc, scene, plotter, times))
             samples[kind].append(sample_loop(rig.clips[name], pose, times))
+        doc.set_current_clip(names["original"])
+        steps["compare"].append(step_loop(doc, scene, plotter, times, compare))
     print(f"{args.rig} {args.clip}: {len(rig.skeleton)} joints, {len(rig.vertices)} vertices, "
           f"{duration:g} s; compressed at {args.max_error:g} cm: {report.lines()[0]}")
     print(f"{args.rounds} rounds x {args.frames} frames, 1280x720 off-screen, "
           f"OMP_NUM_THREADS={os.environ['OMP_NUM_THREADS']}")
-    for kind in names:
-        s, p = np.array(steps[kind]) * 1e3, np.array(samples[kind]) * 1e6
-        print(f"  {kind:10s} step median {np.median(s):7.3f} ms, best {s.min():7.3f} ms "
-              f"({1e3 / np.median(s):5.1f} steps/s); clip.sample median {np.median(p):7.1f} us")
+    for kind in steps:
+        s = np.array(steps[kind]) * 1e3
+        line = (f"  {kind:10s} step median {np.median(s):7.3f} ms, best {s.min():7.3f} ms "
+                f"({1e3 / np.median(s):5.1f} steps/s)")
+        if kind in samples:
+            line += f"; clip.sample median {np.median(samples[kind]) * 1e6:7.1f} us"
+        print(line + ("; the original with View > Compare compressed on" if kind == "compare"
+                      else ""))
     ratio = np.median(steps["compressed"]) / np.median(steps["original"])
     best = min(steps["compressed"]) / min(steps["original"])
     sample = np.median(samples["compressed"]) / np.median(samples["original"])
     print(f"compressed / original: step {ratio:.3f} (median), {best:.3f} (best); "
           f"clip.sample alone {sample:.3f}")
+    print(f"compare on / off: step {np.median(steps['compare']) / np.median(steps['original']):.3f}"
+          f" (median)")
     plotter.close()
 
 

@@ -141,3 +141,21 @@ def test_a_clip_edit_while_on_compresses_again(window, qtbot):
     finally:
         clip.tracks = tracks
         window.compare.set_enabled(False)
+
+
+def test_a_new_rig_while_on_is_compressed_and_drawn_for_its_skeleton(window, qtbot):
+    from builders import cylinder_rig
+
+    quadruped = window.document.rig
+    window.document.set_current_clip("walk")
+    _turn_on(window, qtbot)
+    try:
+        window.document.set_rig(cylinder_rig())   # its clip "bend": 3 joints
+        qtbot.waitUntil(lambda: window.job is None and window.compare.overlay is not None,
+                        timeout=JOB_MS)
+        assert len(window.compare.overlay.positions) == 3
+        assert window.compare.preview.entry.original.name == "bend"
+        assert _layers(window).count(COMPARE_LAYER) == 1   # the old overlay went
+    finally:
+        window.compare.set_enabled(False)
+        window.document.set_rig(quadruped)
