@@ -1,16 +1,17 @@
 """Batch jobs on Dask (issue 21): throughput with 1 and 2 local workers, auto-rigging the
 shared meshes, and the engine's per-task overhead.
 
-Run: ``.venv/bin/python benchmarks/bench_batch.py [--copies N] [--skip-retarget]
+Run: ``.venv/bin/python benchmarks/bench_batch.py [--copies N] [--rounds R] [--skip-retarget]
 [--skip-autorig] [--skip-noop] [--thumbnails]``
 
 **Retarget throughput**: every BVH clip in ``../shared/data/bvh-*`` (12 clips), copied
 ``--copies`` times (3 by default, each copy its own file and task), onto three targets (the
 bundled ``humanoid``, three.js ``Xbot.glb`` and Khronos ``CesiumMan.glb``): at least 100
 tasks, run by ``rigedit.batch.run`` on a local cluster of 1 and then 2 worker processes
-(``--no-thumbnails`` unless ``--thumbnails``). Tasks per second over the whole run (cluster
-start included) and over the tasks alone (first submit to last entry, from the entries'
-times); the ratio 2 workers / 1 worker is measured in the same run. The load average before
+(``--no-thumbnails`` unless ``--thumbnails``), ``--rounds`` pairs of runs with the order
+alternating (the load of other processes drifts). Tasks per second over the whole run (cluster
+start included), the tasks' own seconds summed and their mean; the ratio 2 workers / 1
+worker of each pair is measured in the same run. The load average before
 and after is printed: other processes on the machine share its cores.
 
 **Auto-rig**: ``cow.obj`` (quadruped template) and ``homer.obj`` (humanoid template) from
@@ -62,7 +63,7 @@ def timed_run(job, inputs, out, **options):
     return summary, wall, busy
 
 
-def bench_retarget(tmp, copies, thumbnails):
+def bench_retarget(tmp, copies, thumbnails, rounds=1):
     motions = tmp / "motions"
     motions.mkdir()
     n_clips = copies_of_clips(motions, copies)
@@ -70,16 +71,19 @@ def bench_retarget(tmp, copies, thumbnails):
     print(f"retarget: {n_clips} clips x {copies} copies onto {len(targets)} targets "
           f"({', '.join(Path(t).name for t in targets)}), thumbnails "
           f"{'on' if thumbnails else 'off'}")
-    rates = {}
-    for workers in (1, 2):
-        before = load()
-        s, wall, busy = timed_run("retarget", [motions], tmp / f"retarget{workers}",
-                                  to=targets, workers=workers, thumbnails=thumbnails)
-        rates[workers] = s.tasks / wall
-        print(f"  {workers} worker(s): {s.tasks} tasks, {s.failed} failed, {wall:.1f} s wall "
-              f"({rates[workers]:.2f} tasks/s), task time summed {busy:.1f} s "
-              f"(mean {busy / s.tasks:.3f} s); load avg before {before}, after {load()}")
-    print(f"  throughput 2 workers / 1 worker: {rates[2] / rates[1]:.2f}x")
+    for r in range(rounds):
+        rates = {}
+        for workers in ((1, 2) if r % 2 == 0 else (2, 1)):   # alternate: load drifts
+            before = load()
+            s, wall, busy = timed_run("retarget", [motions], tmp / f"retarget{r}_{workers}",
+                                      to=targets, workers=workers, thumbnails=thumbnails)
+            rates[workers] = s.tasks / wall
+            print(f"  round {r + 1}, {workers} worker(s): {s.tasks} tasks, {s.failed} failed, "
+                  f"{wall:.1f} s wall ({rates[workers]:.2f} tasks/s), task time summed "
+                  f"{busy:.1f} s (mean {busy / s.tasks:.3f} s); load avg before {before}, "
+                  f"after {load()}", flush=True)
+        print(f"  round {r + 1}: throughput 2 workers / 1 worker: {rates[2] / rates[1]:.2f}x",
+              flush=True)
 
 
 def bench_autorig(tmp):
@@ -123,6 +127,8 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--copies", type=int, default=3)
     p.add_argument("--thumbnails", action="store_true")
+    p.add_argument("--rounds", type=int, default=1,
+                   help="pairs of runs (1 and 2 workers, the order alternating)")
     p.add_argument("--skip-retarget", action="store_true")
     p.add_argument("--skip-autorig", action="store_true")
     p.add_argument("--skip-noop", action="store_true")
@@ -133,7 +139,7 @@ def main(argv=None):
         if not args.skip_noop:
             bench_noop(tmp)
         if not args.skip_retarget:
-            bench_retarget(tmp, args.copies, args.thumbnails)
+            bench_retarget(tmp, args.copies, args.thumbnails, args.rounds)
         if not args.skip_autorig:
             bench_autorig(tmp)
     finally:
