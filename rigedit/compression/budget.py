@@ -12,7 +12,9 @@ bound divided by how far its error reaches:
 Errors along a chain add up, so each joint's share of the bound is ``max_error * factor``,
 ``factor = 1 / sqrt(n)`` to start with (``n``: joints on the longest root-to-leaf path through
 the joint); the pipeline halves the factor of the joints on the path of any joint the check
-finds over the bound, and redoes them.
+finds over the bound, and redoes them; once the clip holds, joints whose subtree stayed well
+under the bound get a larger share (:meth:`Budget.relax`) and the clip is encoded again, the
+smallest encoding that holds kept.
 """
 from __future__ import annotations
 
@@ -84,6 +86,20 @@ class Budget:
         if channel == "rotation":
             return share / (2.0 * self.reach[joint])
         return share * max(self.rest_scale[joint], 1e-12) / self.reach[joint]
+
+    def relax(self, joint_error, power=0.7, most=2.0):
+        """Give joints whose whole subtree stayed under the bound a larger share.
+
+        ``joint_error``: (J,) the largest error each joint saw; a joint's share grows by
+        ``(max_error / worst in its subtree) ** power``, at most ``most`` times.
+        """
+        worst = np.asarray(joint_error, dtype=np.float64).copy()
+        for j in range(len(self.skeleton) - 1, 0, -1):
+            p = self.skeleton.parents[j]
+            if p >= 0:
+                worst[p] = max(worst[p], worst[j])
+        gain = (self.max_error / np.maximum(worst, 1e-300)) ** power
+        self.factor *= np.clip(gain, 1.0, most)
 
     def tighten(self, joints, by=0.5):
         """Scale the share of ``joints`` and all their ancestors by ``by``."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["OMITTED", "CONSTANT", "ANIMATED", "distance", "classify"]
+__all__ = ["OMITTED", "CONSTANT", "ANIMATED", "distance", "spread", "classify"]
 
 OMITTED, CONSTANT, ANIMATED = "omitted", "constant", "animated"
 
@@ -28,7 +28,18 @@ def representative(values, rotation):
     return ((values.min(axis=0) + values.max(axis=0)) / 2).astype(np.float32)
 
 
-def classify(values, rest, tol, rotation):
+def spread(values, rest, rotation):
+    """What classifying a track needs, measured once: ``(largest distance to the rest value,
+    largest distance to the stored value, the stored value (C,) float32)``."""
+    to_rest = float(distance(values, rest, rotation).max())
+    value = representative(values, rotation)
+    stored = value.astype(np.float64)
+    if rotation:
+        stored = stored / np.linalg.norm(stored)
+    return to_rest, float(distance(values, stored, rotation).max()), value
+
+
+def classify(values, rest, tol, rotation, measured=None):
     """What a track needs: ``(OMITTED, None)``, ``(CONSTANT, value (C,) float32)`` or
     ``(ANIMATED, None)``.
 
@@ -40,13 +51,13 @@ def classify(values, rest, tol, rotation):
         The joint's rest value (what a decoder gives a track that is not stored).
     tol : float
         In the channel's units.
+    measured : tuple, optional
+        :func:`spread` of the same track (so a track classified at many tolerances is
+        measured once).
     """
-    if distance(values, rest, rotation).max() <= tol:
+    to_rest, to_value, value = spread(values, rest, rotation) if measured is None else measured
+    if to_rest <= tol:
         return OMITTED, None
-    value = representative(values, rotation)
-    stored = value.astype(np.float64)
-    if rotation:
-        stored = stored / np.linalg.norm(stored)
-    if distance(values, stored, rotation).max() <= tol:
+    if to_value <= tol:
         return CONSTANT, value
     return ANIMATED, None

@@ -18,8 +18,8 @@ __all__ = ["QUANTISE_SHARE", "encode_tracks", "gltf_tracks", "gltf_values"]
 QUANTISE_SHARE = 0.8
 
 
-def _classified(values, rest, tol, rotation):
-    kind, value = classify(values, rest, tol, rotation)
+def _classified(values, rest, tol, rotation, measured=None):
+    kind, value = classify(values, rest, tol, rotation, measured)
     if len(values) < 2 and kind == ANIMATED:
         kind, value = CONSTANT, values[0].astype(np.float32)
     return kind, value
@@ -47,9 +47,10 @@ def encode_tracks(items, grid):
 
     Parameters
     ----------
-    items : list of (joint, channel, values (F, C), rest (C,), tol)
-        Each track at every frame, its joint's rest value and its tolerance in the channel's
-        units (quaternion distance for rotations).
+    items : list of (joint, channel, values (F, C), rest (C,), tol[, measured])
+        Each track at every frame, its joint's rest value, its tolerance in the channel's
+        units (quaternion distance for rotations) and optionally its
+        :func:`~rigedit.compression.constant.spread`.
     grid : (F,) float64
         The frame times as decoded.
 
@@ -59,9 +60,9 @@ def encode_tracks(items, grid):
         None: the track is the rest value (not stored).
     """
     out, animated, codes = [None] * len(items), [], []
-    for i, (joint, channel, values, rest, tol) in enumerate(items):
+    for i, (joint, channel, values, rest, tol, *measured) in enumerate(items):
         rotation = channel == "rotation"
-        kind, value = _classified(values, rest, tol, rotation)
+        kind, value = _classified(values, rest, tol, rotation, *measured)
         if kind == CONSTANT:
             out[i] = EncodedTrack(joint, channel, value=value)
         if kind != ANIMATED:
@@ -100,9 +101,9 @@ def gltf_tracks(items, grid):
     ``(times (K,), values (K, C))`` (float32 times, values as :func:`gltf_values`; one key for
     a constant track), or None (the rest)."""
     out, animated, stored_all = [None] * len(items), [], []
-    for i, (joint, channel, values, rest, tol) in enumerate(items):
+    for i, (joint, channel, values, rest, tol, *measured) in enumerate(items):
         rotation = channel == "rotation"
-        kind, value = _classified(values, rest, tol, rotation)
+        kind, value = _classified(values, rest, tol, rotation, *measured)
         if kind == CONSTANT:
             out[i] = grid[:1], gltf_values(value[None].astype(np.float64), rotation)
         if kind != ANIMATED:

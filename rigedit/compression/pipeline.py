@@ -21,7 +21,9 @@ from ..progress import adapt
 from .budget import Budget
 from .compressed_clip import CompressedClip, KeyedClip
 from .encode import encode_tracks, gltf_tracks
+from .constant import spread
 from .error import ErrorMeter
+from .kernels import load
 from .frames import COLUMNS, frame_times
 from .layout import ClipLayout, grid_times, write_clip
 from .quantise import PER_KEY
@@ -38,6 +40,8 @@ SECTION_BYTES = 12
 #: Encodes per clip before giving up (each halves the offending joints' shares: 2^-16 of
 #: the bound is past float32's precision for anything but a microscopic bound).
 MAX_ATTEMPTS = 16
+#: Encodes that try larger shares where the check found room (:meth:`Budget.relax`).
+RELAX_ROUNDS = 3
 _GLTF_MODE = {"translation": "linear", "rotation": "nlerp", "scale": "linear"}
 
 
@@ -103,23 +107,34 @@ def _compress_one(skeleton, clip, max_error, distances, target, shell, mesh):
     rest = Pose(skeleton).as_array()
     sources = [(skeleton.index[name], channel) for name, channel in clip.tracks]
     cache = {}
+    spreads = {(j, c): spread(ref[:, j, COLUMNS[c]], rest[j, COLUMNS[c]], c == "rotation")
+               for j, c in sources}
+    best, relax = None, RELAX_ROUNDS
     for attempt in range(1, MAX_ATTEMPTS + 1):
         tols = {(j, c): budget.tolerance(j, c) for j, c in sources}
         todo = [(j, c) for j, c in sources if cache.get((j, c), (None,))[0] != tols[(j, c)]]
         encode = encode_tracks if target == "rigedit" else gltf_tracks
-        done = encode([(j, c, ref[:, j, COLUMNS[c]], rest[j, COLUMNS[c]], tols[(j, c)])
-                       for j, c in todo], grid)
+        done = encode([(j, c, ref[:, j, COLUMNS[c]], rest[j, COLUMNS[c]], tols[(j, c)],
+                        spreads[(j, c)]) for j, c in todo], grid)
         cache.update({key: (tols[key], enc) for key, enc in zip(todo, done)})
         stored = {key: cache[key][1] for key in sources if cache[key][1] is not None}
         compressed = (_rigedit_clip if target == "rigedit" else _gltf_clip)(
             skeleton, clip, stored, uniform, grid)
         err = meter.error(compressed)
-        if err.max() <= max_error:
-            break
-        budget.tighten(np.flatnonzero(err.max(axis=0) > max_error))
-    else:
+        worst = err.max(axis=0)
+        if worst.max() <= max_error:
+            if best is None or compressed.nbytes < best[0].nbytes:
+                best = (compressed, err, attempt)
+            if not relax:
+                break
+            relax -= 1
+            budget.relax(worst)
+        else:
+            budget.tighten(np.flatnonzero(worst > max_error), 0.5 if best is None else 0.8)
+    if best is None:
         raise ValueError(f"clip {clip.name!r}: cannot hold max_error {max_error:g} m (still "
                          f"{err.max():.3g} m after {MAX_ATTEMPTS} encodes)")
+    compressed, err, attempt = best
     return compressed, err, _row(clip, compressed, err, len(times), attempt, len(sources),
                                  skeleton)
 
@@ -149,7 +164,10 @@ def _rigedit_clip(skeleton, clip, stored, uniform, grid):
     animated = [tr for tr in stored.values() if tr.keys is not None]
     layout = ClipLayout(clip.name, float(clip.duration), clip.loop, grid, uniform,
                         constant, animated)
-    return CompressedClip(skeleton, write_clip(layout))
+    packed = CompressedClip(skeleton, write_clip(layout))
+    if load("reduce_kernels") is not None:   # numba is in already: check with the kernels
+        packed.use_kernels()
+    return packed
 
 
 def _gltf_clip(skeleton, clip, stored, uniform, grid):

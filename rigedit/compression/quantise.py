@@ -134,8 +134,14 @@ def rotation_from_three(three, dropped):
     w = np.sqrt(np.maximum(1.0 - np.sum(three * three, axis=-1), 0.0))
     dropped = np.broadcast_to(np.asarray(dropped, dtype=np.int64), w.shape)
     q = np.empty(three.shape[:-1] + (4,))
-    np.put_along_axis(q, dropped[..., None], w[..., None], axis=-1)
-    np.put_along_axis(q, OTHERS[dropped], three, axis=-1)
+    for c in range(4):           # four masked copies: cheaper than put_along_axis
+        hit = dropped == c
+        if hit.all():
+            q[..., OTHERS[c]] = three
+            q[..., c] = w
+            break
+        if hit.any():
+            q[hit] = np.insert(three[hit], c, w[hit], axis=-1)
     return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
