@@ -21,7 +21,11 @@ runs beside the reference, the rotation track's own ``sample_many`` at the same 
 rotation channel at 1000 times, and one ``CurveDrag.update`` (the clip changed and the pose
 sampled again).
 
-Run: ``.venv/bin/python benchmarks/bench_curves.py [--poses N]``.
+Last, FBX export's refinement of one rotation track (``fbx_write_anim.rotation_keys``, keys
+until FBX's linear Euler keys are within 2e-4 degrees) on a bezier track of the clip, beside
+the same track as slerp.
+
+Run: ``.venv/bin/python benchmarks/bench_curves.py [--poses N] [--repeat N]``.
 """
 from __future__ import annotations
 
@@ -111,6 +115,7 @@ def main():
               f"{rwall * 1e3:7.3f} ms wall, {rcpu * 1e3:7.3f} ms CPU | ratio "
               f"{wall / rwall:5.2f} wall, {cpu / max(rcpu, 1e-9):5.2f} CPU")
     mocap(args.repeat)
+    fbx(plain, bezier, max(3, args.repeat // 3))
 
 
 def _median(fn, repeat):
@@ -158,6 +163,20 @@ def mocap(repeat):
         t = _median(fn, repeat)
         print(f"{name:>18}: {t * 1e3:7.2f} ms median wall, ratio {t / ref:6.1f}")
     drag.cancel()
+
+
+def fbx(plain, bezier, repeat):
+    """FBX's rotation refinement of one bezier track, as a ratio to the slerp track."""
+    from rigedit.io.fbx_write_anim import rotation_keys
+
+    key = ("j5", "rotation")
+    out = {}
+    for name, clip in (("slerp", plain), ("bezier", bezier)):
+        out[name] = (_median(lambda c=clip: rotation_keys(c.tracks[key], 2.0), repeat),
+                     len(rotation_keys(clip.tracks[key], 2.0)[0]))
+    (ts, ns), (tb, nb) = out["slerp"], out["bezier"]
+    print(f"FBX rotation_keys: bezier {tb * 1e3:.0f} ms ({nb} keys), slerp {ts * 1e3:.0f} ms "
+          f"({ns} keys), ratio {tb / ts:.1f}")
 
 
 if __name__ == "__main__":
