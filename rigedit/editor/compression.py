@@ -5,8 +5,8 @@ View > Compare compressed. Pure Python: no Qt, no VTK.
 the rig's data with copies of the chosen clips) and writes it in :meth:`~CompressedExport.run`
 (safe in a worker): ``.glb``/``.gltf`` through :func:`rigedit.io.gltf_compress
 .save_gltf_compressed_rig` (the bound checked on the file as read), ``.rgc`` (rigedit's
-compressed clip file, :mod:`rigedit.io.compressed_file`), or a rig folder whose clips are the
-glTF fit's reduced keys as read. These are the calls ``rigedit compress`` makes
+compressed clip file, :mod:`rigedit.io.compressed_file`), or a rig folder whose clips are
+``animations/NAME.rgc`` compressed clip files. These are the calls ``rigedit compress`` makes
 (:func:`rigedit.cli.compress.compress_and_write`, which the editor may not import).
 Every writer writes a temporary file and renames it: a failed export leaves what was there.
 
@@ -139,34 +139,22 @@ class CompressedExport:
 
                 return save_gltf_compressed_rig(data, self.path, self.names,
                                                 meshopt=self.meshopt, **bound)
+            result = compress_clips(data.skeleton, data.clips, target="rigedit",
+                                    progress=report, **bound)
+            report(1.0, "write")
             if self.kind == "rgc":
                 from ..io.compressed_file import save_compressed
 
-                result = compress_clips(data.skeleton, data.clips, target="rigedit",
-                                        progress=report, **bound)
-                report(1.0, "write")
                 save_compressed(self.path, data.skeleton, result.clips)
-                return result.report
-            return self._folder(report, bound)
+            else:   # a rig folder: each clip as animations/NAME.rgc beside mesh and skeleton
+                from .. import save_rig
+
+                save_rig(dataclasses.replace(data, clips=result.clips), self.path)
+            return result.report
         except ValueError as exc:   # a bound no encoding reaches (RigFileError passes)
             if isinstance(exc, RigFileError):
                 raise
             raise RigFileError(self.path, str(exc)) from None
-
-    def _folder(self, report, bound):
-        """A rig folder whose clips are the glTF fit's keys as read; sizes: the clip files."""
-        from .. import save_rig
-        from ..io.gltf_compress import as_read, fit_clips
-
-        keys, result = fit_clips(self.data.skeleton, self.data.clips, **bound)
-        report(1.0, "write")
-        save_rig(dataclasses.replace(self.data, clips={n: as_read(c) for n, c in keys.items()}),
-                 self.path)
-        for row in result.clips:   # the clip's JSON file as written
-            written = self.path / "animations" / f"{row.name}.json"
-            row.compressed_bytes = written.stat().st_size if written.is_file() else 0
-            row.bytes_by_kind = {"header": row.compressed_bytes}
-        return result
 
 
 def export_compressed(document, path, max_error, shell=DEFAULT_SHELL, clips=None,

@@ -48,6 +48,17 @@ def test_export_glb_holds_the_bound_when_read_back(doc, rig, tmp_path):
     assert report.compressed_bytes > 0 and report.ratio > 1
 
 
+def test_export_folder_holds_the_bound_with_mesh_and_skin(doc, rig, tmp_path):
+    out = tmp_path / "quad"
+    report = export_compressed(doc, out, BOUND, clips=["walk", "run"])
+    back = rigedit.load_rig(out)
+    assert sorted(back.clips) == ["run", "walk"] and len(back.vertices) == len(rig.vertices)
+    for name in back.clips:
+        err = measure_error(rig.skeleton, rig.clips[name], back.clips[name])
+        assert err.max() <= BOUND * (1 + 1e-6)
+    assert report.max_error <= BOUND and report.ratio > 1
+
+
 @pytest.mark.parametrize("kwargs, words", [
     (dict(max_error=0.0), "max_error"), (dict(max_error=float("nan")), "max_error"),
     (dict(shell=-1.0), "shell"), (dict(clips=["gallop"]), "gallop"),
