@@ -14,12 +14,13 @@ animated tracks       varint A, then A track headers:
                       varint joint; uint8 channel (bits 0-1: 0 translation, 1 rotation,
                       2 scale) | rotation mode << 2 (0-3 fixed dropped component, 4 per key);
                       varint K (keys, 2..F); uint8 D (bits per key-frame step, 0: every
-                      frame is a key); per-key rotation: uint8 B (bits of all three
+                      frame is a key, 255: a bit per frame); per-key rotation: uint8 B (bits of all three
                       components); fixed rotation: 3 uint8 bits, 3 uint16 lo, 3 uint16
                       extent (on [-1, 1]: lo16 * 2 / 65535 - 1, ext16 * 2 / 65535);
                       translation, scale: 3 uint8 bits, 3 float32 lo, 3 float32 extent
-bit stream            varint n words, n uint32 words: first every animated track's K - 1
-                      key-frame steps (D bits each; the first key is frame 0), then every
+bit stream            varint n words, n uint32 words: first every animated track's key
+                      frames (D = 255: F bits, 1 where a frame is a key; else K - 1 steps
+                      of D bits each, the first key frame 0), then every
                       animated track's K keys, each [2 bits dropped component, per-key
                       rotations only] + 3 components of their bits
 ====================  ======================================================================
@@ -99,6 +100,22 @@ def varint(n):
             return bytes(out)
 
 
+#: Key-frame code D meaning "a bit per frame" (1: a key) instead of steps.
+MASK = 255
+
+
+def key_code(keys, count):
+    """How a track's key frames are stored: ``(D, bits)``: D = 0 every frame is a key (no
+    bits), :data:`MASK` one bit per frame, else K - 1 steps of D bits; the cheaper of the last
+    two."""
+    keys = np.asarray(keys, dtype=np.int64)
+    if len(keys) == count:
+        return 0, 0
+    dbits = max(int(np.diff(keys).max()).bit_length(), 1)
+    steps = (len(keys) - 1) * dbits
+    return (MASK, count) if count < steps else (dbits, steps)
+
+
 def write_clip(layout):
     """The blob of a :class:`ClipLayout`, bytes."""
     out = bytearray()
@@ -120,8 +137,7 @@ def write_clip(layout):
     for tr in layout.animated:
         keys = np.asarray(tr.keys, dtype=np.int64)
         steps = np.diff(keys)
-        every = len(keys) == count
-        dbits = 0 if every else max(int(steps.max()).bit_length(), 1)
+        dbits = key_code(keys, count)[0]
         out += varint(tr.joint) + bytes([CHANNEL_CODES[tr.channel] | (tr.mode << 2)])
         out += varint(len(keys)) + bytes([dbits])
         if tr.mode == PER_KEY:
@@ -134,7 +150,12 @@ def write_clip(layout):
             else:
                 out += np.asarray(tr.code.lo, dtype="<f4").tobytes()
                 out += np.asarray(tr.code.ext, dtype="<f4").tobytes()
-        if dbits:
+        if dbits == MASK:
+            mask = np.zeros(count, dtype=np.uint64)
+            mask[keys] = 1
+            fields.append(mask)
+            widths.append(np.ones(count, dtype=np.int64))
+        elif dbits:
             fields.append(steps)
             widths.append(np.full(len(steps), dbits))
     for tr in layout.animated:
@@ -246,7 +267,7 @@ def read_clip(blob, num_joints):
             raise LayoutError(f"clip {name!r}: unknown track code {code}")
         keys = r.varint("key count", count)
         dbits = r.u8("key step bits")
-        if keys < 2 or count < 2 or dbits > 32 or (dbits == 0 and keys != count):
+        if keys < 2 or count < 2 or (32 < dbits < MASK) or (dbits == 0 and keys != count):
             raise LayoutError(f"clip {name!r}: {keys} keys of {count} frames, step bits "
                               f"{dbits}")
         if mode == PER_KEY:
@@ -283,7 +304,7 @@ def _key_frames(layout, stream, dbits_all):
     count = len(layout.times)
     need = 0
     for tr, dbits in zip(layout.animated, dbits_all):
-        need += (tr.keys - 1) * dbits
+        need += count if dbits == MASK else (tr.keys - 1) * dbits
     offsets = []
     value_bits = need
     for tr in layout.animated:
@@ -300,9 +321,17 @@ def _key_frames(layout, stream, dbits_all):
         if dbits == 0:
             tr.keys = np.arange(count)
             continue
-        steps = read_fields(words, at + np.arange(k - 1) * dbits, dbits).astype(np.int64)
-        at += (k - 1) * dbits
-        keys = np.concatenate([[0], np.cumsum(steps)])
+        if dbits == MASK:
+            keys = np.flatnonzero(read_fields(words, at + np.arange(count), 1))
+            at += count
+            steps = np.diff(keys)
+            if len(keys) != k or keys[0] != 0:
+                raise LayoutError(f"clip {layout.name!r}: a track's key mask holds "
+                                  f"{len(keys)} keys, its header {k}")
+        else:
+            steps = read_fields(words, at + np.arange(k - 1) * dbits, dbits).astype(np.int64)
+            at += (k - 1) * dbits
+            keys = np.concatenate([[0], np.cumsum(steps)])
         if np.any(steps <= 0) or keys[-1] != count - 1:
             raise LayoutError(f"clip {layout.name!r}: key frames of a track do not run from "
                               f"the first frame to the last")

@@ -25,7 +25,7 @@ from .constant import spread
 from .error import ErrorMeter
 from .kernels import load
 from .frames import COLUMNS, frame_times
-from .layout import ClipLayout, grid_times, write_clip
+from .layout import ClipLayout, grid_times, key_code, write_clip
 from .quantise import PER_KEY
 from .report import RAW_BYTES_PER_JOINT_FRAME, ClipRow, CompressionReport
 from .virtual import DEFAULT_SHELL, check_shell, shell_distances
@@ -90,8 +90,7 @@ def _kinds(layout, size):
         k = len(tr.keys)
         stride = int(np.sum(tr.code.bits)) + (2 if tr.mode == PER_KEY else 0)
         kinds[tr.channel] += k * stride / 8
-        if k != frames:
-            kinds["times"] += (k - 1) * max(int(np.diff(tr.keys).max()).bit_length(), 1) / 8
+        kinds["times"] += key_code(tr.keys, frames)[1] / 8
     kinds = {k: int(round(v)) for k, v in kinds.items()}
     kinds["header"] = size - sum(v for k, v in kinds.items() if k != "header")
     return kinds

@@ -70,3 +70,17 @@ def test_compiled_reduction_keeps_the_same_keys():
                           reduce_keys(times, vec, vec, tol, False))
     kept = slow.sum(axis=1)
     assert kept[2] < 100 and kept[4] < 100 and kept[3] > kept[0] > kept[1] > kept[2]
+
+
+def test_key_frames_as_steps_or_a_mask_decode_the_same():
+    from rigedit.compression.layout import MASK, key_code
+    sk = chain(6, 0.1)
+    clip = mocap_clip(sk, frames=300)
+    packed = compress_clips(sk, {"take": clip}, max_error=3e-4).clips["take"]
+    frames = len(packed.layout.times)
+    codes = {key_code(tr.keys, frames)[0] for tr in packed.layout.animated}
+    assert MASK in codes and codes - {0, MASK}     # both kinds in one clip
+    again = read_clip(packed.blob, len(sk))[0]
+    for a, b in zip(packed.layout.animated, again.animated):
+        assert np.array_equal(a.keys, b.keys)
+    assert key_code([0, 5, 9], 10) == (3, 6) and key_code([0, 1, 2, 4, 9], 10) == (MASK, 10)
