@@ -10,9 +10,11 @@ into edits. A channel here is a :class:`rigedit.editor.graph_commands.ChannelVie
 Cost: a curve is drawn as one polyline sampled once per pixel column (``sample`` on (W,)
 times), keys as one ``drawPoints`` call per channel from numpy through the polygon's buffer
 (no Python object per key), only the keys in the visible time range; where neighbouring keys
-are closer than :data:`DENSE_PX` pixels (a mocap clip: a key per frame) they are drawn as a
-thick line through them instead of points. Everything but the time cursor is cached in a
-pixmap, so playback (the cursor moving) repaints two thin strips, as the timeline does.
+are closer than :data:`DENSE_PX` pixels (a mocap clip: a key per frame) they are drawn as
+small touching squares, one per pixel, which read as a thick line along the curve. Everything
+but the time cursor is cached in a pixmap, so playback (the cursor moving) repaints two thin
+strips, as the timeline does. ``benchmarks/bench_graph_paint.py`` measures a repaint: 3
+channels of 100,000 keys in 58 ms, 1/75 of drawing each key with its own call.
 """
 from __future__ import annotations
 
@@ -27,7 +29,7 @@ __all__ = ["GraphView", "polygon", "DENSE_PX"]
 RULER_H, LEFT, RIGHT, BOTTOM = 20, 52, 10, 6
 #: Keys closer than this (pixels) to a neighbour are drawn as a line, not as points.
 DENSE_PX = 4.0
-KEY_PX, SELECTED_PX, HANDLE_PX = 5.0, 7.0, 6.0
+KEY_PX, DENSE_KEY_PX, SELECTED_PX, HANDLE_PX = 5.0, 3.0, 7.0, 6.0
 CURSOR_W = 3
 SELECTED = QtGui.QColor("#ffb347")
 HANDLE_LINE = QtGui.QColor(200, 200, 200, 170)
@@ -309,7 +311,9 @@ class GraphView(QtWidgets.QWidget):
 
     def _paint_curve(self, p, channel, times):
         values = np.asarray(channel.sample(times), dtype=float)
-        p.setPen(QtGui.QPen(_colour(channel.colour), 1.5))
+        # 1 px: a wider antialiased polyline of a noisy 1,000-column curve cost ~40 ms
+        # under Xvfb, 1 px ~1 ms
+        p.setPen(QtGui.QPen(_colour(channel.colour), 1.0))
         p.drawPolyline(polygon(self.transform.x_of(times), self.transform.y_of(values)))
 
     def _paint_keys(self, p, channel):
@@ -318,16 +322,20 @@ class GraphView(QtWidgets.QWidget):
             return
         colour = _colour(channel.colour).lighter(130)
         dense = dense_mask(xs, ys)
-        if dense.any():   # runs of close keys: one thick line through them (pairs)
-            pair = dense[:-1] & dense[1:]
-            a = np.flatnonzero(pair)
-            seg_x = np.column_stack([xs[a], xs[a + 1]]).ravel()
-            seg_y = np.column_stack([ys[a], ys[a + 1]]).ravel()
-            p.setPen(QtGui.QPen(colour, 3.0, QtCore.Qt.SolidLine, QtCore.Qt.RoundCap))
-            p.drawLines(polygon(seg_x, seg_y))
+        if dense.any():
+            # close keys: small squares that touch along the curve, so they read as a thick
+            # line; a key on the same pixel as the one before is not drawn again (keys are
+            # in time order, so this is one pass, no sort). Square points cost ~1 ms per
+            # 1,000 where a 3 px antialiased polyline cost ~40 ms (measured under Xvfb)
+            dx, dy = np.round(xs[dense]), np.round(ys[dense])
+            new = np.ones(len(dx), dtype=bool)
+            new[1:] = (dx[1:] != dx[:-1]) | (dy[1:] != dy[:-1])
+            p.setRenderHint(QtGui.QPainter.Antialiasing, False)
+            p.setPen(QtGui.QPen(colour, DENSE_KEY_PX, QtCore.Qt.SolidLine, QtCore.Qt.SquareCap))
+            p.drawPoints(polygon(dx[new], dy[new]))
+            p.setRenderHint(QtGui.QPainter.Antialiasing, True)
         lone = ~dense
-        pen = QtGui.QPen(colour, KEY_PX, QtCore.Qt.SolidLine, QtCore.Qt.SquareCap)
-        p.setPen(pen)
+        p.setPen(QtGui.QPen(colour, KEY_PX, QtCore.Qt.SolidLine, QtCore.Qt.SquareCap))
         p.drawPoints(polygon(xs[lone], ys[lone]))
         sel = self.selected.get(channel.id)
         if sel is not None and len(sel):
