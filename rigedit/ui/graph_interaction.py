@@ -309,8 +309,11 @@ class GraphInteraction(QtCore.QObject):
         return self.commands.delete_keys(self.document, sel)
 
     def insert_keys(self):
-        """A key on every shown channel at the time cursor (one undo step)."""
-        ids = [c.id for c in self.view.visible_channels()]
+        """A key on every shown channel at the time cursor (one undo step); on a joint with
+        no keys in the clip, on each of its channels not unticked (all nine at first)."""
+        view = self.view
+        ids = ([c.id for c in view.visible_channels()]
+               or [c.id for c in view.channels if c.id not in view.hidden])
         if not ids:
             self.status("Graph editor: no shown channel to key")
             return 0

@@ -384,3 +384,20 @@ def test_an_undo_during_a_drag_ends_the_drag_without_an_edit(window):
     rest_y = d.skeleton.rest_translation[d.skeleton.index[JOINT], 1]
     assert _height(window, 0.3) == pytest.approx(rest_y + 0.2)
     assert d.undo_stack.redo_label.startswith("Delete")
+
+
+def test_i_on_a_joint_without_keys_keys_its_channels_at_the_cursor(window):
+    d, view = window.document, window.graph_editor.view
+    d.select("spine_1")
+    assert view.visible_channels() == [] and view.message.startswith("spine_1 has no keys")
+    d.set_time(0.4)
+    view.setFocus()
+    QTest.keyClick(view, QtCore.Qt.Key_I)
+    shown = view.visible_channels()
+    assert {c.id.channel for c in shown} == {"translation", "rotation", "scale"}
+    assert all(c.curve.times.tolist() == [0.4] for c in shown)
+    j = d.skeleton.index["spine_1"]
+    pose = d.sample(0.4)
+    assert np.allclose(pose.rotation[j], d.skeleton.rest_rotation[j]) or np.allclose(
+        pose.rotation[j], -d.skeleton.rest_rotation[j])
+    assert ("spine_1", "rotation") in d.clip.tracks
