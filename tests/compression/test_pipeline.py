@@ -112,3 +112,24 @@ def test_rigedit_compress_on_a_rig():
     assert skin["bend"].nbytes >= clips["bend"].nbytes
     with pytest.raises(ValueError, match="'nope'"):
         rigedit.compress(rig, clips=["nope"])
+
+
+def test_gltf_target_keys_are_what_gltf_holds():
+    from rigedit.compression import KeyedClip
+    sk = chain(8, 0.1)
+    clip = mocap_clip(sk, frames=120, rate=30.0)
+    result = compress_clips(sk, {"take": clip}, max_error=1e-4, target="gltf")
+    keyed = result.clips["take"]
+    assert isinstance(keyed, KeyedClip) and result.report.max_error <= 1e-4
+    assert measure_error(sk, clip, keyed).max() <= 1e-4
+    plain = keyed.to_clip()
+    rot = plain.tracks[("j0", "rotation")]
+    assert rot.interpolation == "nlerp" and 2 <= len(rot) <= 120
+    assert np.array_equal(rot.times, rot.times.astype(np.float32))
+    # rotations on the normalised int16 grid (up to the unit normalisation Track applies)
+    codes = rot.values * 32767
+    assert np.abs(codes - np.round(codes)).max() < 2.0
+    move = plain.tracks[("j0", "translation")]
+    assert np.array_equal(move.values, move.values.astype(np.float32))
+    with pytest.raises(ValueError, match="target"):
+        compress_clips(sk, {"take": clip}, target="fbx")
