@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
+from types import MappingProxyType
 
 import numpy as np
 
@@ -30,7 +31,8 @@ from ..errors import RigFileError
 from ..model.pose import Pose
 
 __all__ = ["GLTF_SUFFIXES", "COMPRESSED_SUFFIX", "CompressedExport", "export_compressed",
-           "output_kind", "CompressedPreview", "PreviewEntry"]
+           "output_kind", "CompressedPreview", "PreviewEntry", "ReadOnlyCompressedClip",
+           "shown_clips"]
 
 GLTF_SUFFIXES = (".glb", ".gltf")
 #: rigedit's compressed clip file (:data:`rigedit.io.compressed_file.SUFFIX`).
@@ -338,3 +340,69 @@ class CompressedPreview:
         if frame_errors is not None:
             line += f", this frame {float(np.max(frame_errors)) * 100:.4f} cm"
         return line
+
+
+# ---------------------------------------------------------------------- compressed clips opened
+#: What a plain clip can do that a compressed one refuses (its keys are its bits).
+_EDITS = ("state", "restore", "set_track", "remove_track", "set_morph_track",
+          "remove_morph_track", "set_morph_key", "set_key", "key_pose", "delete_keys",
+          "move_keys", "paste_keys", "set_interpolation", "set_duration")
+
+
+def _refuse(name):
+    def refused(self, *args, **kwargs):
+        raise ValueError(f"clip {self.name!r} is compressed (played as stored): its keys "
+                         "cannot be edited; edit the original clip and export it compressed again")
+    refused.__name__ = name
+    refused.__doc__ = "Refused: a compressed clip is not edited (``ValueError``)."
+    return refused
+
+
+class ReadOnlyCompressedClip(CompressedClip):
+    """A compressed clip as the editor's views read a clip: its stored keys as a read-only
+    ``tracks`` mapping (what the timeline and the camera's carrier check read), played from
+    its bits; every edit one ``ValueError`` that says why.
+
+    Parameters
+    ----------
+    clip : CompressedClip
+    """
+
+    def __init__(self, clip):
+        super().__init__(clip.skeleton, clip.blob)
+        self._tracks = None
+
+    @property
+    def tracks(self):
+        """``{(joint name, channel): Track}`` of the stored keys (read-only, dequantised as
+        decoded: :meth:`CompressedClip.to_clip`)."""
+        if self._tracks is None:
+            self._tracks = MappingProxyType(self.to_clip().tracks)
+        return self._tracks
+
+    def morph_key_times(self, target=None):
+        return np.zeros(0)
+
+    def copy_keys(self, t, joints=None):
+        """The stored keys' values at ``t`` (Copy works; Paste into a plain clip)."""
+        return self.to_clip().copy_keys(t, joints)
+
+    def copy(self, name=None):
+        """The same bits (a compressed clip does not change); ``name`` is refused, as a
+        rename."""
+        if name is not None and name != self.name:
+            _refuse("copy")(self)
+        return self
+
+
+for _edit in _EDITS:
+    setattr(ReadOnlyCompressedClip, _edit, _refuse(_edit))
+
+
+def shown_clips(rig):
+    """``rig`` with each :class:`CompressedClip` of ``rig.clips`` replaced (in place) by a
+    :class:`ReadOnlyCompressedClip` of the same bits, as the window opens it; returns it."""
+    for name, clip in list(rig.clips.items()):
+        if isinstance(clip, CompressedClip) and not isinstance(clip, ReadOnlyCompressedClip):
+            rig.clips[name] = ReadOnlyCompressedClip(clip)
+    return rig
