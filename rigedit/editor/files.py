@@ -23,6 +23,7 @@ from ..io.mesh import load_mesh
 from ..io.rig_folder import read_rig_folder
 from ..io.skeleton_json import load_skeleton, save_skeleton
 from ..rig import Rig
+from .compression import shown_clips   # compressed clips open read-only
 from .recompute import compute_weights_for
 
 __all__ = ["open_document", "open_rig", "save_rig_folder", "export_rig", "load_rig",
@@ -40,10 +41,10 @@ def load_rig(path=None, quiet=False, **options):
     from .. import load_rig as _load_rig
 
     if not quiet:
-        return _load_rig(path, **options)
+        return shown_clips(_load_rig(path, **options))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return _load_rig(path, **options)
+        return shown_clips(_load_rig(path, **options))
 
 
 def load_rig_folder(path):
@@ -51,7 +52,7 @@ def load_rig_folder(path):
     animations); weights computed where the folder has none, without a warning."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # "weights computed" is expected, not an error
-        return Rig.from_data(read_rig_folder(path))
+        return shown_clips(Rig.from_data(read_rig_folder(path)))
 
 
 def load_mesh_skeleton(mesh_path, skeleton_path, progress=None):
