@@ -147,3 +147,27 @@ def test_a_bound_no_encoding_reaches_names_the_file(doc, tmp_path):
     job = CompressedExport(doc, tmp_path / "w.rgc", 1e-12, clips=["head_nod"])
     with pytest.raises(RigFileError, match="w.rgc"):
         job.run()
+
+
+def test_compressed_clips_open_read_only_and_play_their_bits(doc, tmp_path):
+    from rigedit.compression import CompressedClip
+    from rigedit.editor import files
+    from rigedit.editor.compression import ReadOnlyCompressedClip
+
+    out = tmp_path / "walk.rgc"
+    export_compressed(doc, out, BOUND, clips=["walk"])
+    plain = rigedit.load_rig(out).clips["walk"]
+    clip = files.load_rig(out).clips["walk"]
+    assert isinstance(clip, ReadOnlyCompressedClip) and isinstance(clip, CompressedClip)
+    assert set(clip.tracks) == set(plain.to_clip().tracks)
+    with pytest.raises(TypeError):
+        clip.tracks[("root", "rotation")] = None   # the mapping is read-only
+    for t in (0.0, 0.4, 1.1):
+        np.testing.assert_array_equal(clip.sample(t).as_array(), plain.sample(t).as_array())
+    before = clip.key_times()
+    for edit in (lambda: clip.set_key("root", "rotation", 0.5, [0, 0, 0, 1]),
+                 lambda: clip.state(), lambda: clip.set_duration(2.0)):
+        with pytest.raises(ValueError, match="compressed"):
+            edit()
+    np.testing.assert_array_equal(clip.key_times(), before)
+    assert clip.copy() is clip

@@ -159,3 +159,32 @@ def test_a_new_rig_while_on_is_compressed_and_drawn_for_its_skeleton(window, qtb
     finally:
         window.compare.set_enabled(False)
         window.document.set_rig(quadruped)
+
+
+@pytest.mark.parametrize("kind", ["walk.rgc", "folder"])
+def test_compressed_clips_open_play_and_refuse_edits(window, qtbot, tmp_path, kind):
+    from rigedit.editor.compression import ReadOnlyCompressedClip, export_compressed
+
+    original = window.document.rig.clips["walk"]
+    out = tmp_path / kind
+    export_compressed(window.document, out, 1e-3, clips=["walk"])
+    (window.files.open_file if kind.endswith(".rgc") else window.files.open_folder)(str(out))
+    _wait_job(qtbot, window)
+    doc = window.document
+    assert window.last_error is None and isinstance(doc.clip, ReadOnlyCompressedClip)
+    assert doc.current_clip == "walk"
+    rest = doc.rig.rest_pose().as_array()
+    for t in (0.2, 0.7):
+        doc.set_time(t)
+        shown = doc.pose.as_array()
+        assert not np.allclose(shown, rest)
+        np.testing.assert_allclose(shown, doc.clip.sample(t).as_array())
+        # the compressed pose is the original's within the bound (positions, 1 mm)
+        gap = np.linalg.norm(window.scene.joint_positions - doc.rig.joint_matrices(
+            original.sample(t, out=doc.rig.rest_pose()))[:, :3, 3], axis=1)
+        assert gap.max() <= 1e-3
+    keys = doc.clip.key_times()
+    with pytest.raises(ValueError, match="cannot be edited"):
+        window.timeline.keys.insert_key(all_joints=True)
+    np.testing.assert_array_equal(doc.clip.key_times(), keys)
+    assert doc.undo_stack.top is None   # nothing was recorded
