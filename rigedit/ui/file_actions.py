@@ -149,7 +149,7 @@ class FileActions:
         if check is None:
             return None
         path = path or self._ask_open("Open glTF or BVH file",
-                                      "Rigs and motion (*.glb *.gltf *.fbx *.bvh)")
+                                      "Rigs and motion (*.glb *.gltf *.fbx *.bvh *.rgc)")
         if not path:
             return None
         # what the reader decided (a BVH's unit guess) is in rig.notes for the status bar
