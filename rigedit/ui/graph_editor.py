@@ -76,6 +76,8 @@ class GraphEditor:
         parent.splitDockWidget(timeline, self.dock, QtCore.Qt.Vertical)
         self.dock.hide()
         self.dock.visibilityChanged.connect(lambda shown: shown and self._catch_up())
+        # the frame numbers on the graph's ruler are the timeline's frames
+        timeline.fps_spin.valueChanged.connect(lambda _fps: self.view.update_view())
         self._joint = None     # the joint shown (framing is redone when it changes)
         self._stale = True
         document.listen(self._on_event)
