@@ -401,3 +401,19 @@ def test_i_on_a_joint_without_keys_keys_its_channels_at_the_cursor(window):
     assert np.allclose(pose.rotation[j], d.skeleton.rest_rotation[j]) or np.allclose(
         pose.rotation[j], -d.skeleton.rest_rotation[j])
     assert ("spine_1", "rotation") in d.clip.tracks
+
+
+def test_esc_during_a_key_drag_puts_the_key_back_without_an_undo_step(window):
+    d, view = window.document, _only(window, T_Y)
+    times = np.linspace(0, 1, 21)
+    before = [_height(window, t) for t in times]
+    start = _key_pos(view, T_Y, 1)
+    QTest.mousePress(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
+    _move(view, start + QtCore.QPoint(60, 40))
+    assert not np.allclose([_height(window, t) for t in times], before)   # live
+    QTest.keyClick(view, QtCore.Qt.Key_Escape)
+    QTest.mouseRelease(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier,
+                       start + QtCore.QPoint(60, 40))
+    assert np.allclose([_height(window, t) for t in times], before, atol=1e-12)
+    assert d.undo_stack.undo_label == ""
+    assert np.allclose(d.pose.translation, d.sample().translation)
