@@ -30,8 +30,27 @@ class _Sampled:
         pose.set_array(self.sample_many(np.array([float(t)]))[0])
         return pose
 
+    def plain(self):
+        """:meth:`to_clip`, made once and kept: what readers of a clip's keys (writers,
+        listings, the timeline) see."""
+        if getattr(self, "_plain", None) is None:
+            self._plain = self.to_clip()
+        return self._plain
+
+    @property
+    def tracks(self):
+        """The stored keys as plain tracks, ``{(joint, channel): Track}`` (read only)."""
+        return self.plain().tracks
+
     def key_times(self, joint=None):
-        return self.to_clip().key_times(joint)
+        return self.plain().key_times(joint)
+
+    def morph_key_times(self, target=None):
+        return np.zeros(0)
+
+    def copy(self, name=None):
+        """A plain, editable :class:`Clip` of the stored keys."""
+        return self.to_clip(name)
 
 
 class CompressedClip(_Sampled):

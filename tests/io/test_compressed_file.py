@@ -126,3 +126,17 @@ def test_rig_folder_refuses_a_compressed_clip_of_other_joints(tmp_path):
     save_compressed(tmp_path / "rig" / "animations" / "x.rgc", other, packed)
     with pytest.raises(RigFileError, match="x.rgc.*joints"):
         rigedit.load_rig(tmp_path / "rig")
+
+
+def test_a_compressed_rig_saves_to_other_formats(written, tmp_path):
+    path, sk, clips, result = written
+    rig = rigedit.load_rig(path)
+    with pytest.warns(UserWarning):   # the writer says how to read a small figure back
+        rigedit.save_rig(rig, tmp_path / "a.bvh", clips=["a"])
+    back = rigedit.load_rig(tmp_path / "a.bvh", scale=0.01)
+    from rigedit.compression import measure_error
+    err = measure_error(sk, clips["a"], back.clips[next(iter(back.clips))])
+    assert err.max() < 2e-4      # the bound, plus BVH's printed digits
+    copy = rig.clips["a"].copy("edit me")
+    copy.set_key("j1", "rotation", 0.1, [0, 0, 0, 1])   # a plain clip: editable
+    assert copy.name == "edit me" and ("j1", "rotation") in rig.clips["a"].tracks
