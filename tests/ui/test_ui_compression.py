@@ -188,3 +188,32 @@ def test_compressed_clips_open_play_and_refuse_edits(window, qtbot, tmp_path, ki
         window.timeline.keys.insert_key(all_joints=True)
     np.testing.assert_array_equal(doc.clip.key_times(), keys)
     assert doc.undo_stack.top is None   # nothing was recorded
+
+
+def test_the_dialog_writes_meshopt_gltf_when_asked(window, qtbot, tmp_path):
+    import json
+    import struct
+
+    from rigedit.io.gltf_write_compact import meshopt_available
+
+    if not meshopt_available():
+        pytest.skip("the meshopt package is not installed")
+    part = window.export_compressed
+    dialog = part.dialog()
+    out = tmp_path / "run.glb"
+    dialog.path_edit.setText(str(out))
+    assert dialog.meshopt_box.isEnabled()
+    dialog.meshopt_box.setChecked(True)
+    dialog.max_error_edit.setText("0.1")
+    _check_only(dialog, ["run"])
+    dialog.accept()
+    part.start(dialog.export)
+    _wait_job(qtbot, window)
+    blob = out.read_bytes()
+    length, = struct.unpack("<I", blob[12:16])
+    gltf = json.loads(blob[20:20 + length])
+    assert "EXT_meshopt_compression" in gltf.get("extensionsRequired", [])
+    assert [a.get("name") for a in gltf["animations"]] == ["run"]
+    assert part.last_report.max_error <= 1e-3
+    dialog.path_edit.setText(str(tmp_path / "run.rgc"))   # not glTF: the box goes off
+    assert not dialog.meshopt_box.isEnabled() and not dialog.meshopt_box.isChecked()
