@@ -133,3 +133,15 @@ def test_gltf_target_keys_are_what_gltf_holds():
     assert np.array_equal(move.values, move.values.astype(np.float32))
     with pytest.raises(ValueError, match="target"):
         compress_clips(sk, {"take": clip}, target="fbx")
+
+
+def test_report_bytes_add_up_and_read_in_centimetres():
+    sk = chain(5, 0.1)
+    clips = {"a": mocap_clip(sk, 50, name="a"), "b": mocap_clip(sk, 80, seed=2, name="b")}
+    report = compress_clips(sk, clips, max_error=2e-4).report
+    assert sum(report.bytes_by_kind.values()) == report.compressed_bytes
+    assert report.raw_bytes == 40 * 5 * (50 + 80)
+    assert report.ratio == pytest.approx(report.raw_bytes / report.compressed_bytes)
+    lines = report.lines()
+    assert "bound 0.02 cm" in lines[0] and len(lines) == 2 + len(clips)
+    assert report.p99_error <= report.max_error <= 2e-4

@@ -140,3 +140,34 @@ def test_a_compressed_rig_saves_to_other_formats(written, tmp_path):
     copy = rig.clips["a"].copy("edit me")
     copy.set_key("j1", "rotation", 0.1, [0, 0, 0, 1])   # a plain clip: editable
     assert copy.name == "edit me" and ("j1", "rotation") in rig.clips["a"].tracks
+
+
+def test_well_checksummed_nonsense_is_one_error(written, tmp_path):
+    """A file whose CRCs match but whose contents do not make sense (a writer's bug, a
+    crafted file): one RigFileError, never a traceback or a huge allocation."""
+    import struct
+    import zlib
+    path, sk, *_ = written
+    blob = path.read_bytes()
+    size = struct.unpack("<I", blob[16:20])[0]
+    skel = bytearray(blob[24:24 + size])
+    clip_at = 24 + size
+    bad = tmp_path / "crafted.rgc"
+
+    def write(skel_payload, rest=blob[clip_at:]):
+        head = b"RGC1" + struct.pack("<HHI", 1, 0, 1 + (len(rest) > 0) * 2)
+        bad.write_bytes(head + b"SKEL" + struct.pack("<II", len(skel_payload),
+                                                     zlib.crc32(skel_payload))
+                        + skel_payload + rest)
+
+    cyclic = bytearray(skel)
+    at = 1 + sum(1 + len(n.encode()) for n in sk.names)
+    cyclic[at:at + 4] = struct.pack("<i", 5)          # the root's parent after it
+    write(bytes(cyclic))
+    with pytest.raises(RigFileError, match="crafted.rgc"):
+        read_clip_file(bad)
+    huge = bytearray(skel)
+    huge[0:1] = b"\x7f"                                   # 127 joints claimed
+    write(bytes(huge))
+    with pytest.raises(RigFileError, match="crafted.rgc"):
+        read_clip_file(bad)
