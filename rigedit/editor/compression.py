@@ -17,6 +17,7 @@ are and how far each one's virtual vertices are from the original's.
 from __future__ import annotations
 
 import dataclasses
+import os
 from pathlib import Path
 from types import MappingProxyType
 
@@ -137,10 +138,7 @@ class CompressedExport:
         data = self.data
         try:
             if self.kind == "gltf":
-                from ..io.gltf_compress import save_gltf_compressed_rig
-
-                return save_gltf_compressed_rig(data, self.path, self.names,
-                                                meshopt=self.meshopt, **bound)
+                return self._gltf(report, bound)
             result = compress_clips(data.skeleton, data.clips, target="rigedit",
                                     progress=report, **bound)
             report(1.0, "write")
@@ -157,6 +155,23 @@ class CompressedExport:
             if isinstance(exc, RigFileError):
                 raise
             raise RigFileError(self.path, str(exc)) from None
+
+
+    def _gltf(self, report, bound):
+        """Compact glTF written beside ``path`` and renamed onto it once ``report`` (its last
+        chance to cancel: the compressor takes no progress) lets it."""
+        from ..io.gltf_compress import save_gltf_compressed_rig
+
+        path = self.path
+        partial = path.with_name(f".{path.stem}.{os.getpid()}.partial{path.suffix}")
+        try:
+            result = save_gltf_compressed_rig(self.data, partial, self.names,
+                                              meshopt=self.meshopt, **bound)
+            report(1.0, "write")
+            os.replace(partial, path)
+        finally:
+            partial.unlink(missing_ok=True)
+        return result
 
 
 def export_compressed(document, path, max_error, shell=DEFAULT_SHELL, clips=None,

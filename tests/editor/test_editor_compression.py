@@ -86,6 +86,18 @@ def test_a_failed_write_keeps_the_old_file(doc, tmp_path, monkeypatch):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["walk.rgc"]
 
 
+@pytest.mark.parametrize("name", ["run.glb", "run.rgc", "folder"])
+def test_a_cancel_before_the_write_leaves_nothing(doc, tmp_path, name):
+    from rigedit.progress import Cancelled
+
+    def progress(fraction, stage=None):
+        if stage == "write":
+            raise Cancelled()
+    with pytest.raises(Cancelled):
+        export_compressed(doc, tmp_path / name, BOUND, clips=["run"], progress=progress)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_the_export_compresses_what_the_document_held_when_made(doc, tmp_path):
     clip = doc.rig.clips["walk"]
     tracks = dict(clip.tracks)
