@@ -62,6 +62,7 @@ class GraphEditor:
     def __init__(self, parent, document, timeline, status):
         self.document, self.status = document, status
         self.view = GraphView(lambda: timeline.fps)
+        self.view.selection_changed.connect(self._show_handle_type)
         self.channel_list = ChannelList()
         self.channel_list.visibility_changed.connect(self._on_visibility)
         self.interaction = GraphInteraction(self.view, document, graph_commands,
@@ -161,6 +162,17 @@ class GraphEditor:
     def set_easing(self, name):
         """Easing preset ``name`` on the selected keys (one undo step)."""
         return self._per_key(graph_commands.set_easing, name, "an easing")
+
+    def _show_handle_type(self):
+        """The Handles box shows the first selected key's out-handle type."""
+        view = self.view
+        for c in view.visible_channels():
+            idx = view.selected.get(c.id)
+            if idx is not None and len(idx):
+                row = self.handle_combo.findData(str(c.curve.right_type[idx[0]]))
+                if row >= 0:
+                    self.handle_combo.setCurrentIndex(row)   # activated is not emitted
+                return
 
     def _ask_scale(self):
         if not self.interaction.selection():

@@ -96,6 +96,9 @@ class GraphView(QtWidgets.QWidget):
         Shown in the middle when there is no channel (why the graph is empty).
     """
 
+    #: The selected keys changed (read :attr:`selected`).
+    selection_changed = QtCore.pyqtSignal()
+
     def __init__(self, fps, parent=None):
         super().__init__(parent)
         self.fps = fps
@@ -126,6 +129,7 @@ class GraphView(QtWidgets.QWidget):
         self.selected = {k: np.unique(np.asarray(v, dtype=int)) for k, v in selected.items()
                          if len(v)}
         self.update_view()
+        self.selection_changed.emit()
 
     def selection_count(self):
         return int(sum(len(v) for v in self.selected.values()))

@@ -417,3 +417,19 @@ def test_esc_during_a_key_drag_puts_the_key_back_without_an_undo_step(window):
     assert np.allclose([_height(window, t) for t in times], before, atol=1e-12)
     assert d.undo_stack.undo_label == ""
     assert np.allclose(d.pose.translation, d.sample().translation)
+
+
+def test_the_handles_box_shows_and_sets_the_selected_keys_handle_type(window):
+    view = _only(window, T_Y)
+    ge = window.graph_editor
+    QTest.mouseClick(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, _key_pos(view, T_Y, 1))
+    assert ge.handle_combo.currentData() == str(_channel(view, T_Y).curve.right_type[1])
+    row = ge.handle_combo.findData("vector")
+    ge.handle_combo.setCurrentIndex(row)
+    ge.handle_combo.activated.emit(row)          # what choosing it in the box does
+    cv = _channel(view, T_Y).curve
+    assert (cv.left_type[1], cv.right_type[1]) == ("vector", "vector")
+    assert cv.right_type[0] != "vector"          # only the selected key
+    QTest.mouseClick(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, _key_pos(view, T_Y, 2))
+    shown = ge.handle_combo.currentData()
+    assert shown == str(_channel(view, T_Y).curve.right_type[2]) and shown != "vector"
