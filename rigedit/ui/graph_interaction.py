@@ -1,7 +1,8 @@
 """The graph editor's mouse and keys: selection, key and handle drags, scaling, framing.
 
 :class:`GraphInteraction` filters the canvas's (:class:`~.graph_view.GraphView`) input events
-and turns them into the editor's graph commands (:mod:`rigedit.editor.graph_commands`). Every
+(the gesture in progress is one of :mod:`.graph_gestures`) and turns them into the editor's
+graph commands (:mod:`rigedit.editor.graph_commands`). Every
 edit is one undo step: a drag (keys, a handle, an S scale) runs through one ``CurveDrag``
 (live updates, one step at the release); Delete, I and the tool row's edits are one command
 each. The document then emits ``KeysChanged`` and the dock shows the clip again, as do the 3D
@@ -31,6 +32,8 @@ import numpy as np
 from PyQt5 import QtCore
 
 from ..editor.playback import snap_to_frame
+from .graph_gestures import (Box, HandleDrag, KeyDrag, Pan, Scale, Scrub, scaled_curves,
+                             selected_curves)
 
 __all__ = ["GraphInteraction", "PICK_PX"]
 
@@ -100,28 +103,28 @@ class GraphInteraction(QtCore.QObject):
     def _press(self, e):
         pos, mods = e.pos(), e.modifiers()
         g = self._gesture
-        if isinstance(g, _Scale):
+        if isinstance(g, Scale):
             self._end(cancel=e.button() != QtCore.Qt.LeftButton)
             return True
         if g is not None:
             return True
         if e.button() == QtCore.Qt.MiddleButton:
-            self._gesture = _Pan(pos)
+            self._gesture = Pan(pos)
             return True
         if e.button() != QtCore.Qt.LeftButton:
             return False
         if self.view.in_ruler(pos):
-            self._gesture = _Scrub()
+            self._gesture = Scrub()
             self._scrub(pos)
             return True
         shift = bool(mods & QtCore.Qt.ShiftModifier)
         handle = self.handle_at(pos)
         if handle is not None:
-            self._gesture = _HandleDrag(pos, *handle)
+            self._gesture = HandleDrag(pos, *handle)
             return True
         key = self.key_at(pos)
         if key is None:
-            self._gesture = _Box(pos, shift)
+            self._gesture = Box(pos, shift)
             return True
         cid, k = key
         chosen = k in self.view.selected.get(cid, ())
@@ -130,26 +133,26 @@ class GraphInteraction(QtCore.QObject):
             return True
         if not chosen:
             self._select({cid: [k]}, add=shift)
-        self._gesture = _KeyDrag(pos, cid, k)
+        self._gesture = KeyDrag(pos, cid, k)
         return True
 
     def _move(self, e):
         g, pos = self._gesture, e.pos()
         if g is None:
             return False
-        if isinstance(g, _Pan):
+        if isinstance(g, Pan):
             d = pos - g.last
             g.last = pos
             self.view.transform.pan(d.x(), d.y())
             self.view.update_view()
-        elif isinstance(g, _Scrub):
+        elif isinstance(g, Scrub):
             self._scrub(pos)
-        elif isinstance(g, _Box):
+        elif isinstance(g, Box):
             g.end = pos
             self.view.rubber_band = QtCore.QRectF(QtCore.QPointF(g.start),
                                                   QtCore.QPointF(pos)).normalized()
             self.view.update()
-        elif isinstance(g, (_KeyDrag, _HandleDrag, _Scale)):
+        elif isinstance(g, (KeyDrag, HandleDrag, Scale)):
             if not g.moved and (pos - g.start).manhattanLength() < DRAG_PX:
                 return True
             g.moved = True
@@ -163,11 +166,11 @@ class GraphInteraction(QtCore.QObject):
 
     def _release(self, e):
         g = self._gesture
-        if g is None or isinstance(g, _Scale):
+        if g is None or isinstance(g, Scale):
             return g is not None
-        if isinstance(g, _Pan) and e.button() != QtCore.Qt.MiddleButton:
+        if isinstance(g, Pan) and e.button() != QtCore.Qt.MiddleButton:
             return True
-        if isinstance(g, _Box):
+        if isinstance(g, Box):
             self.view.rubber_band = None
             rect = QtCore.QRectF(QtCore.QPointF(g.start), QtCore.QPointF(g.end)).normalized()
             if rect.width() < DRAG_PX and rect.height() < DRAG_PX and not g.add:
@@ -195,7 +198,7 @@ class GraphInteraction(QtCore.QObject):
                 self._end(cancel=True)
             return True
         if k in (QtCore.Qt.Key_Return, QtCore.Qt.Key_Enter):
-            if isinstance(g, _Scale):
+            if isinstance(g, Scale):
                 self._end()
             return True
         if g is not None:
@@ -324,104 +327,12 @@ class GraphInteraction(QtCore.QObject):
         if not self.selection():
             self.status("Graph editor: select keys to scale")
             return
-        self._gesture = _Scale(self, self._mouse)
+        self._gesture = Scale(self, self._mouse)
         self.status("Scale: move the mouse; click or Enter to finish, Esc to cancel")
 
     def scale_selected(self, time_factor, value_factor=1.0):
         """Scale the selected keys about the time cursor (time) and 0 (value): one step."""
-        curves = _scaled(self, time_factor, value_factor)
+        curves = scaled_curves(self, time_factor, value_factor)
         if not curves:
             return 0
         return self.commands.edit_curves(self.document, curves, "Scale keys")
-
-
-def _base_curves(interaction):
-    """ChannelId -> (curve, selected indices) of the shown channels with selected keys."""
-    view = interaction.view
-    return {c.id: (c.curve, view.selected[c.id]) for c in view.visible_channels()
-            if len(view.selected.get(c.id, ()))}
-
-
-def _scaled(interaction, time_factor, value_factor, base=None):
-    base = _base_curves(interaction) if base is None else base
-    pivot = interaction.document.time
-    return {cid: cv.scaled(idx, pivot, time_factor, 0.0, value_factor)
-            for cid, (cv, idx) in base.items()}
-
-
-# ====================================================================== gestures
-class _Pan:
-    def __init__(self, pos):
-        self.last = pos
-
-
-class _Scrub:
-    pass
-
-
-class _Box:
-    def __init__(self, pos, add):
-        self.start = self.end = pos
-        self.add = add
-
-
-class _KeyDrag:
-    """The selected keys follow the mouse; the grabbed key's time lands on a frame."""
-
-    label = "Move keys"
-
-    def __init__(self, pos, cid, index):
-        self.start, self.cid, self.index = pos, cid, index
-        self.moved, self.drag, self.base = False, None, None
-
-    def curves(self, interaction, pos, free):
-        if self.base is None:   # the curves as they were when the drag began
-            self.base = _base_curves(interaction)
-        tr = interaction.view.transform
-        grabbed = self.base[self.cid][0]
-        t_key = float(grabbed.times[self.index])
-        t_new = t_key + float(tr.t_of(pos.x()) - tr.t_of(self.start.x()))
-        if not free:
-            t_new = snap_to_frame(t_new, interaction.fps())
-        dt = t_new - t_key
-        dv = float(tr.v_of(pos.y()) - tr.v_of(self.start.y()))
-        return {cid: cv.with_keys_moved(idx, dt, dv) for cid, (cv, idx) in self.base.items()}
-
-
-class _HandleDrag:
-    label = "Move handle"
-
-    def __init__(self, pos, cid, index, side, curve):
-        self.start, self.cid, self.index, self.side, self.base = pos, cid, index, side, curve
-        self.moved, self.drag = False, None
-        h = curve.left[index] if side == "left" else curve.right[index]
-        self.grab = np.asarray(h, dtype=float).copy()
-
-    def curves(self, interaction, pos, free):
-        tr = interaction.view.transform
-        point = (self.grab[0] + float(tr.t_of(pos.x()) - tr.t_of(self.start.x())),
-                 self.grab[1] + float(tr.v_of(pos.y()) - tr.v_of(self.start.y())))
-        return {self.cid: self.base.with_handle(self.index, self.side, point)}
-
-
-class _Scale:
-    """The time factor is the mouse's distance from the cursor over its distance at S (or,
-    when S was pressed near the cursor, 1 + the mouse's travel over 200 pixels)."""
-
-    label = "Scale keys"
-
-    def __init__(self, interaction, pos):
-        self.start, self.moved, self.drag = pos, True, None
-        self.base = _base_curves(interaction)
-        self.x_pivot = float(interaction.view.transform.x_of(interaction.document.time))
-
-    def curves(self, interaction, pos, free):
-        reach = self.start.x() - self.x_pivot
-        factor = ((pos.x() - self.x_pivot) / reach if abs(reach) >= 20
-                  else 1.0 + (pos.x() - self.start.x()) / 200.0)
-        if not free:
-            factor = round(factor * 20) / 20   # steps of 0.05; Ctrl: free
-        if abs(factor) < 0.05:                 # keys do not collapse onto one time
-            factor = 0.05 if factor >= 0 else -0.05
-        interaction.status(f"Scale: x{factor:.2f} about {interaction.document.time:.3f} s")
-        return _scaled(interaction, factor, 1.0, self.base)
