@@ -10,7 +10,9 @@ bundled ``humanoid``, three.js ``Xbot.glb`` and Khronos ``CesiumMan.glb``): at l
 tasks, run by ``rigedit.batch.run`` on a local cluster of 1 and then 2 worker processes
 (``--no-thumbnails`` unless ``--thumbnails``), ``--rounds`` pairs of runs with the order
 alternating (the load of other processes drifts). Tasks per second over the whole run (cluster
-start included), the tasks' own seconds summed and their mean; the ratio 2 workers / 1
+start included), the tasks' own seconds summed and their mean, and the workers' CPU seconds
+(``getrusage`` of the ended worker processes: CPU per task, and CPU / wall = the cores the
+batch got, which tells a slow run from a machine that other work keeps busy); the ratio 2 workers / 1
 worker of each pair is measured in the same run. The load average before
 and after is printed: other processes on the machine share its cores.
 
@@ -25,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
 import sys
 import tempfile
@@ -53,14 +56,22 @@ def copies_of_clips(folder, copies):
     return len(clips)
 
 
+def children_cpu():
+    """CPU seconds of this process's ended children (the local cluster's workers)."""
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return ru.ru_utime + ru.ru_stime
+
+
 def timed_run(job, inputs, out, **options):
+    """``rigedit.batch.run``: its summary, wall seconds, the tasks' summed seconds and the
+    workers' CPU seconds."""
     from rigedit.batch import run
 
-    t0 = time.perf_counter()
+    cpu, t0 = children_cpu(), time.perf_counter()
     summary = run(job, inputs, out, **options)
     wall = time.perf_counter() - t0
     busy = sum(e["seconds"] or 0 for e in summary.entries)
-    return summary, wall, busy
+    return summary, wall, busy, children_cpu() - cpu
 
 
 def bench_retarget(tmp, copies, thumbnails, rounds=1):
@@ -75,13 +86,14 @@ def bench_retarget(tmp, copies, thumbnails, rounds=1):
         rates = {}
         for workers in ((1, 2) if r % 2 == 0 else (2, 1)):   # alternate: load drifts
             before = load()
-            s, wall, busy = timed_run("retarget", [motions], tmp / f"retarget{r}_{workers}",
-                                      to=targets, workers=workers, thumbnails=thumbnails)
+            s, wall, busy, cpu = timed_run("retarget", [motions], tmp / f"retarget{r}_{workers}",
+                                           to=targets, workers=workers, thumbnails=thumbnails)
             rates[workers] = s.tasks / wall
             print(f"  round {r + 1}, {workers} worker(s): {s.tasks} tasks, {s.failed} failed, "
                   f"{wall:.1f} s wall ({rates[workers]:.2f} tasks/s), task time summed "
-                  f"{busy:.1f} s (mean {busy / s.tasks:.3f} s); load avg before {before}, "
-                  f"after {load()}", flush=True)
+                  f"{busy:.1f} s (mean {busy / s.tasks:.3f} s), workers' CPU {cpu:.1f} s "
+                  f"({cpu / s.tasks:.3f} s a task, {cpu / wall:.2f} cores used); load avg "
+                  f"before {before}, after {load()}", flush=True)
         print(f"  round {r + 1}: throughput 2 workers / 1 worker: {rates[2] / rates[1]:.2f}x",
               flush=True)
 
@@ -92,7 +104,7 @@ def bench_autorig(tmp):
         if not (meshes / mesh).exists():
             print(f"autorig: {mesh} missing, skipped")
             continue
-        s, wall, busy = timed_run("autorig", [meshes / mesh], tmp / f"autorig_{template}",
+        s, wall, busy, _ = timed_run("autorig", [meshes / mesh], tmp / f"autorig_{template}",
                                   template=template, workers=2)
         e = s.entries[0]
         print(f"autorig {mesh} ({template}): {e['status']}, task {e['seconds']:.1f} s, "
