@@ -79,7 +79,9 @@ class GraphEditor:
         self.dock.visibilityChanged.connect(lambda shown: shown and self._catch_up())
         # the frame numbers on the graph's ruler are the timeline's frames
         timeline.fps_spin.valueChanged.connect(lambda _fps: self.view.update_view())
-        self._joint = None     # the joint shown (framing is redone when it changes)
+        # what is shown: (rig, clip, joint); when it changes the key selection is dropped
+        # and the view framed again
+        self._shown = None
         self._stale = True
         document.listen(self._on_event)
 
@@ -209,7 +211,8 @@ class GraphEditor:
         joint = d.selection
         name = None if joint is None else d.skeleton.names[joint]
         chans = [] if joint is None else graph_commands.channels(d, [joint])
-        if name != self._joint:
+        shown = (id(d.rig), d.current_clip, name)
+        if shown != self._shown:
             view.selected = {}
         self.channel_list.set_channels(chans)
         view.hidden = self.channel_list.hidden
@@ -221,8 +224,8 @@ class GraphEditor:
         view.set_channels(chans)
         # (not in the dock's title: that is the View menu's text too)
         self.joint_label.setText("no joint" if name is None else name)
-        if name != self._joint:
-            self._joint = name
+        if shown != self._shown:
+            self._shown = shown
             view.frame_all()
 
     def _on_visibility(self):

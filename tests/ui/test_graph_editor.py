@@ -433,3 +433,15 @@ def test_the_handles_box_shows_and_sets_the_selected_keys_handle_type(window):
     QTest.mouseClick(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, _key_pos(view, T_Y, 2))
     shown = ge.handle_combo.currentData()
     assert shown == str(_channel(view, T_Y).curve.right_type[2]) and shown != "vector"
+
+
+def test_another_clip_drops_the_key_selection_and_frames_its_keys(window):
+    d, view = window.document, _only(window, T_Y)
+    QTest.mouseClick(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, _key_pos(view, T_Y, 1))
+    assert view.selected
+    d.set_current_clip("walk")
+    assert view.selected == {}
+    walk = d.clip.duration
+    assert view.duration == walk and view.transform.t1 >= walk     # the walk framed
+    d.set_current_clip("sway")
+    assert view.selected == {} and view.duration == 1.0
