@@ -367,16 +367,18 @@ _EDITS = ("state", "restore", "set_track", "remove_track", "set_morph_track",
 def _refuse(name):
     def refused(self, *args, **kwargs):
         raise ValueError(f"clip {self.name!r} is compressed (played as stored): its keys "
-                         "cannot be edited; edit the original clip and export it compressed again")
+                         "cannot be edited; Duplicate it (a plain copy of its keys) to edit")
     refused.__name__ = name
     refused.__doc__ = "Refused: a compressed clip is not edited (``ValueError``)."
     return refused
 
 
 class ReadOnlyCompressedClip(CompressedClip):
-    """A compressed clip as the editor's views read a clip: its stored keys as a read-only
-    ``tracks`` mapping (what the timeline and the camera's carrier check read), played from
-    its bits; every edit one ``ValueError`` that says why.
+    """A compressed clip as the window holds it: its stored keys
+    (:meth:`CompressedClip.plain`) as a read-only ``tracks`` mapping, the pose decoded from
+    its bits, and every key edit one ``ValueError`` that says why, before anything changes
+    (a plain :class:`CompressedClip` has no edit methods: an edit was an ``AttributeError``).
+    :meth:`copy` (Duplicate) gives a plain, editable clip of the stored keys.
 
     Parameters
     ----------
@@ -385,29 +387,15 @@ class ReadOnlyCompressedClip(CompressedClip):
 
     def __init__(self, clip):
         super().__init__(clip.skeleton, clip.blob)
-        self._tracks = None
 
     @property
     def tracks(self):
-        """``{(joint name, channel): Track}`` of the stored keys (read-only, dequantised as
-        decoded: :meth:`CompressedClip.to_clip`)."""
-        if self._tracks is None:
-            self._tracks = MappingProxyType(self.to_clip().tracks)
-        return self._tracks
-
-    def morph_key_times(self, target=None):
-        return np.zeros(0)
+        """``{(joint name, channel): Track}`` of the stored keys, read-only."""
+        return MappingProxyType(self.plain().tracks)
 
     def copy_keys(self, t, joints=None):
-        """The stored keys' values at ``t`` (Copy works; Paste into a plain clip)."""
-        return self.to_clip().copy_keys(t, joints)
-
-    def copy(self, name=None):
-        """The same bits (a compressed clip does not change); ``name`` is refused, as a
-        rename."""
-        if name is not None and name != self.name:
-            _refuse("copy")(self)
-        return self
+        """The stored keys' values at ``t`` (Copy works; Paste goes into a plain clip)."""
+        return self.plain().copy_keys(t, joints)
 
 
 for _edit in _EDITS:

@@ -182,4 +182,8 @@ def test_compressed_clips_open_read_only_and_play_their_bits(doc, tmp_path):
         with pytest.raises(ValueError, match="compressed"):
             edit()
     np.testing.assert_array_equal(clip.key_times(), before)
-    assert clip.copy() is clip
+    duplicate = clip.copy("walk copy")   # Duplicate: a plain clip of the stored keys, editable
+    assert not isinstance(duplicate, CompressedClip) and duplicate.name == "walk copy"
+    np.testing.assert_allclose(duplicate.sample(0.4).as_array(), clip.sample(0.4).as_array(),
+                               atol=1e-6)
+    duplicate.set_key("root", "rotation", 0.5, [0, 0, 0, 1])
