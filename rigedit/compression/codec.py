@@ -15,7 +15,7 @@ import numpy as np
 from .bits import read_fields, words_of
 from .frames import COLUMNS
 from .kernels import load, loaded
-from .quantise import OTHERS, PER_KEY
+from .quantise import OTHERS, PER_KEY, SEGMENT, segment_range
 
 __all__ = ["ClipDecoder", "kernels", "kernels_loaded"]
 
@@ -67,19 +67,9 @@ class ClipDecoder:
         keys = [times[tr.keys] for tr in tracks]
         self.key_times = np.concatenate(keys) if keys else np.zeros(0)
         self.shifted = self.key_times + np.repeat(self.shift, lengths)
-        bits = np.array([tr.code.bits for tr in tracks], dtype=np.int64).reshape(-1, 3)
         per_key = np.array([tr.mode == PER_KEY for tr in tracks], dtype=bool)
-        lead = np.where(per_key, 2, 0)
-        self.value_offset = np.asarray(offsets, dtype=np.int64)
-        self.stride = bits.sum(axis=1) + lead
-        self.field_offset = lead[:, None] + np.concatenate(
-            [np.zeros((self.count, 1), np.int64), np.cumsum(bits, axis=1)[:, :2]], axis=1)
-        self.bits = bits
-        lo = np.array([tr.code.lo for tr in tracks], dtype=np.float64).reshape(-1, 3)
-        ext = np.array([tr.code.ext for tr in tracks], dtype=np.float64).reshape(-1, 3)
-        levels = (np.left_shift(1, bits) - 1).astype(np.float64)
-        self.scale = np.where(levels > 0, ext / np.maximum(levels, 1), 0.0)
-        self.lo = np.where(levels > 0, lo, lo + ext / 2)
+        lead = np.where(per_key, 2, 0).astype(np.int64)
+        self._segment_tables(tracks, offsets, lead)
         self.per_key = per_key
         self.fixed = np.array([0 if tr.mode == PER_KEY else tr.mode for tr in tracks],
                               dtype=np.int64)
@@ -92,12 +82,69 @@ class ClipDecoder:
         self.rot_target = (joint[self.rot] * 10 + 3)[:, None] + np.arange(4)
         self.rot_per_key = per_key[self.rot]
         self.itab = np.column_stack([
-            self.start, lengths, self.value_offset, self.stride, lead, bits,
-            rot.astype(np.int64), joint * 10 + first, self.fixed]).astype(np.int64) \
-            if self.count else np.zeros((0, 11), dtype=np.int64)
-        self.ftab = np.ascontiguousarray(np.column_stack([self.lo, self.scale])) \
-            if self.count else np.zeros((0, 6))
+            self.start, lengths, lead, rot.astype(np.int64), joint * 10 + first,
+            self.fixed]).astype(np.int64) if self.count else np.zeros((0, 6), dtype=np.int64)
+        self.sitab = np.ascontiguousarray(np.column_stack([
+            self.seg_offset, self.seg_first, self.seg_stride, self.seg_field,
+            self.seg_bits]).astype(np.int64))
+        self.sftab = np.ascontiguousarray(np.column_stack([self.seg_lo, self.seg_scale]))
         self.compiled = None
+
+    def _segment_tables(self, tracks, offsets, lead):
+        """Per segment of stored keys (a whole track when it is not segmented): bit offset of
+        its first key, that key's index in the track, the stride, the three fields' offsets
+        and bits, lo and scale; ``key_seg``: each key's segment. Decoded once, at opening."""
+        cols = {k: [] for k in ("offset", "first", "stride", "bits", "lo", "ext")}
+        key_seg, total = [], 0
+        for i, tr in enumerate(tracks):
+            lo = np.asarray(tr.code.lo, dtype=np.float64)
+            ext = np.asarray(tr.code.ext, dtype=np.float64)
+            k = len(tr.keys)
+            if tr.segments is None:
+                s_lo, s_ext = lo[None], ext[None]
+                s_bits = np.asarray(tr.code.bits, dtype=np.int64)[None]
+                index = np.zeros(k, dtype=np.int64)
+            else:
+                used, a, b, s_bits = tr.segments
+                s_lo, s_ext = segment_range(lo, ext, a, b)
+                index = np.searchsorted(used, tr.keys // SEGMENT)
+            counts = np.bincount(index, minlength=len(s_bits))
+            stride = s_bits.sum(axis=1) + lead[i]
+            cols["offset"].append(offsets[i] + np.concatenate([[0], np.cumsum(counts * stride)
+                                                               [:-1]]))
+            cols["first"].append(np.concatenate([[0], np.cumsum(counts)[:-1]]))
+            cols["stride"].append(stride)
+            cols["bits"].append(s_bits)
+            cols["lo"].append(s_lo)
+            cols["ext"].append(s_ext)
+            key_seg.append(index + total)
+            total += len(s_bits)
+        cat = {k: (np.concatenate(v) if v else np.zeros((0, 3) if k in ("bits", "lo", "ext")
+                                                       else 0)) for k, v in cols.items()}
+        bits = cat["bits"].astype(np.int64).reshape(-1, 3)
+        self.seg_offset = cat["offset"].astype(np.int64)
+        self.seg_first = cat["first"].astype(np.int64)
+        self.seg_stride = cat["stride"].astype(np.int64)
+        self.seg_bits = bits
+        seg_lead = np.repeat(lead, [len(b) for b in cols["bits"]]) if tracks else \
+            np.zeros(0, dtype=np.int64)
+        self.seg_field = seg_lead[:, None] + np.concatenate(
+            [np.zeros((len(bits), 1), np.int64), np.cumsum(bits, axis=1)[:, :2]], axis=1)
+        levels = (np.left_shift(1, bits) - 1).astype(np.float64)
+        lo, ext = cat["lo"].reshape(-1, 3), cat["ext"].reshape(-1, 3)
+        self.seg_scale = np.where(levels > 0, ext / np.maximum(levels, 1), 0.0)
+        self.seg_lo = np.where(levels > 0, lo, lo + ext / 2)
+        self.key_seg = np.concatenate(key_seg).astype(np.int64) if key_seg else \
+            np.zeros(0, dtype=np.int64)
+
+    def _fields(self, global_key, track):
+        """Bit offset (...) of keys given by global index and their track (broadcast), the
+        three components (..., 3) and the segment (...)."""
+        seg = self.key_seg[global_key]
+        local = global_key - self.start[track]
+        at = self.seg_offset[seg] + (local - self.seg_first[seg]) * self.seg_stride[seg]
+        codes = read_fields(self.words, at[..., None] + self.seg_field[seg], self.seg_bits[seg])
+        return at, self.seg_lo[seg] + codes * self.seg_scale[seg]
 
     def use_kernels(self, on=True):
         """Decode with the compiled kernels (when numba is there) or with numpy."""
@@ -107,8 +154,8 @@ class ClipDecoder:
     def pose_into(self, t, out):
         """One pose at clip time ``t`` into ``out`` (J * 10,) float64."""
         if self.compiled is not None:
-            self.compiled.pose_at(float(t), self.itab, self.ftab, self.key_times, self.words,
-                                  self.base, out)
+            self.compiled.pose_at(float(t), self.itab, self.sitab, self.sftab, self.key_seg,
+                                  self.key_times, self.words, self.base, out)
         else:
             out[:] = self.local_many(np.array([float(t)])).reshape(-1)
         return out
@@ -121,11 +168,8 @@ class ClipDecoder:
         i = np.clip(pos, self.start, self.last)                       # (N, T)
         t0, t1 = self.key_times[i], self.key_times[i + 1]
         u = np.clip((t[:, None] - t0) / (t1 - t0), 0.0, 1.0)
-        key = (i - self.start)[..., None] + np.arange(2)              # (N, T, 2)
-        at = self.value_offset[:, None] + key * self.stride[:, None]  # (N, T, 2)
-        codes = read_fields(self.words, at[..., None] + self.field_offset[:, None, :],
-                            self.bits[:, None, :])                    # (N, T, 2, 3)
-        comps = self.lo[:, None, :] + codes * self.scale[:, None, :]
+        key = i[..., None] + np.arange(2)                             # (N, T, 2)
+        at, comps = self._fields(key, np.arange(self.count)[:, None])  # (N, T, 2, 3)
         vec = comps[:, self.vec]
         a, b = vec[:, :, 0], vec[:, :, 1]
         uv = u[:, self.vec, None]
@@ -150,8 +194,8 @@ class ClipDecoder:
         t = np.asarray(t, dtype=np.float64).reshape(-1)
         if self.compiled is not None:
             out = np.empty((len(t), len(self.base)))
-            self.compiled.poses_at(t, self.itab, self.ftab, self.key_times, self.words,
-                                   self.base, out)
+            self.compiled.poses_at(t, self.itab, self.sitab, self.sftab, self.key_seg,
+                                   self.key_times, self.words, self.base, out)
             return out.reshape(len(t), self.num_joints, 10)
         out = np.repeat(self.base[None], len(t), axis=0)
         if self.count:
@@ -164,9 +208,7 @@ class ClipDecoder:
         """Key times (K,) and decoded values (K, C) of animated track ``index``."""
         tr = self.layout.animated[index]
         k = len(tr.keys)
-        at = self.value_offset[index] + np.arange(k) * self.stride[index]
-        codes = read_fields(self.words, at[:, None] + self.field_offset[index], self.bits[index])
-        comps = self.lo[index] + codes * self.scale[index]
+        at, comps = self._fields(self.start[index] + np.arange(k), index)
         times = self.key_times[self.start[index]:self.start[index] + k]
         if tr.channel != "rotation":
             return times, comps

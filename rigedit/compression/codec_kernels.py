@@ -7,10 +7,12 @@ this module, once, on first use, and caches the compiled code on disk with
 ``cache=True``); :class:`~rigedit.compression.codec.ClipDecoder`'s numpy path is the
 reference and the fallback (``RIGEDIT_NO_NUMBA=1``). The tables are built by the decoder:
 
-``itab`` (T, 11) int64 per animated track: key start, key count, value bit offset, stride,
-lead bits (2 for per-key rotations), the three component bits, is-rotation, target column
-(joint * 10 + first column), fixed dropped component; ``ftab`` (T, 6) float64: lo (3),
-scale (3).
+``itab`` (T, 6) int64 per animated track: key start, key count, lead bits (2 for per-key
+rotations), is-rotation, target column (joint * 10 + first column), fixed dropped component;
+``sitab`` (S, 9) int64 per segment of stored keys (a whole track when not segmented): bit
+offset of its first key, that key's index in its track, stride, the three fields' offsets,
+the three fields' bits; ``sftab`` (S, 6) float64: lo (3), scale (3); ``key_seg`` (K,) each
+key's segment.
 """
 from __future__ import annotations
 
@@ -30,20 +32,18 @@ def _field(words, pos, bits):
 
 
 @numba.njit(cache=True)
-def _decode_key(words, itab, ftab, k, key, others, q):
-    """Key ``key`` of track ``k`` into q[0:3] (vector) or q[0:4] (rotation)."""
-    pos = itab[k, 2] + key * itab[k, 3]
-    lead = itab[k, 4]
-    dropped = itab[k, 10]
-    if lead:
+def _decode_key(words, itab, sitab, sftab, key_seg, k, gkey, others, q):
+    """Key ``gkey`` (global index) of track ``k`` into q[0:3] (vector) or q[0:4] (rotation)."""
+    g = key_seg[gkey]
+    pos = sitab[g, 0] + (gkey - itab[k, 0] - sitab[g, 1]) * sitab[g, 2]
+    dropped = itab[k, 5]
+    if itab[k, 2]:
         dropped = np.int64(_field(words, pos, 2))
-    pos += lead
-    rotation = itab[k, 8] != 0
+    rotation = itab[k, 3] != 0
     w2 = 1.0
     for m in range(3):
-        bits = itab[k, 5 + m]
-        c = ftab[k, m] + np.float64(_field(words, pos, bits)) * ftab[k, 3 + m]
-        pos += bits
+        c = sftab[g, m] + np.float64(_field(words, pos + sitab[g, 3 + m], sitab[g, 6 + m])) \
+            * sftab[g, 3 + m]
         if rotation:
             q[others[dropped, m]] = c
             w2 -= c * c
@@ -54,7 +54,7 @@ def _decode_key(words, itab, ftab, k, key, others, q):
 
 
 @numba.njit(cache=True)
-def _pose(t, itab, ftab, key_times, words, others, out, a, b):
+def _pose(t, itab, sitab, sftab, key_seg, key_times, words, others, out, a, b):
     for k in range(itab.shape[0]):
         lo = itab[k, 0]
         hi = lo + itab[k, 1] - 1
@@ -71,11 +71,10 @@ def _pose(t, itab, ftab, key_times, words, others, out, a, b):
                     hi = mid
             i = lo
             u = (t - key_times[i]) / (key_times[i + 1] - key_times[i])
-        key = i - itab[k, 0]
-        _decode_key(words, itab, ftab, k, key, others, a)
-        _decode_key(words, itab, ftab, k, key + 1, others, b)
-        col = itab[k, 9]
-        if itab[k, 8] == 0:
+        _decode_key(words, itab, sitab, sftab, key_seg, k, i, others, a)
+        _decode_key(words, itab, sitab, sftab, key_seg, k, i + 1, others, b)
+        col = itab[k, 4]
+        if itab[k, 3] == 0:
             for m in range(3):
                 out[col + m] = a[m] + (b[m] - a[m]) * u
         else:
@@ -91,20 +90,20 @@ def _pose(t, itab, ftab, key_times, words, others, out, a, b):
 
 
 @numba.njit(cache=True)
-def pose_at(t, itab, ftab, key_times, words, base, out):
+def pose_at(t, itab, sitab, sftab, key_seg, key_times, words, base, out):
     """One pose at clip time ``t`` into ``out`` (J * 10,) float64 (``base``: the rest with the
     constant tracks)."""
     out[:] = base
     a = np.empty(4)
     b = np.empty(4)
-    _pose(t, itab, ftab, key_times, words, _OTHERS, out, a, b)
+    _pose(t, itab, sitab, sftab, key_seg, key_times, words, _OTHERS, out, a, b)
 
 
 @numba.njit(cache=True)
-def poses_at(times, itab, ftab, key_times, words, base, out):
+def poses_at(times, itab, sitab, sftab, key_seg, key_times, words, base, out):
     """Poses at clip times (N,) into ``out`` (N, J * 10) float64."""
     a = np.empty(4)
     b = np.empty(4)
     for n in range(times.shape[0]):
         out[n, :] = base
-        _pose(times[n], itab, ftab, key_times, words, _OTHERS, out[n], a, b)
+        _pose(times[n], itab, sitab, sftab, key_seg, key_times, words, _OTHERS, out[n], a, b)

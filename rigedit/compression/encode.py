@@ -6,7 +6,8 @@ import numpy as np
 
 from .constant import ANIMATED, CONSTANT, classify
 from .layout import EncodedTrack
-from .quantise import VectorCode, quantise_rotations, quantise_vectors, rotation_from_three
+from .quantise import (OTHERS, PER_KEY, VectorCode, quantise_rotations, quantise_vectors,
+                       rotation_from_three, segment_vectors)
 from .reduce import reduce_keys
 
 __all__ = ["QUANTISE_SHARE", "encode_tracks", "gltf_tracks", "gltf_values"]
@@ -16,6 +17,9 @@ __all__ = ["QUANTISE_SHARE", "encode_tracks", "gltf_tracks", "gltf_values"]
 #: more per component halves the quantisation error; the share was picked by measurement
 #: (docs/compression.md).
 QUANTISE_SHARE = 0.8
+#: A track is segmented when that takes under this part of its unsegmented bits (at every
+#: frame, headers counted): key reduction then keeps fewer keys a segment header pays for.
+SEGMENT_GAIN = 0.9
 
 
 def _classified(values, rest, tol, rotation, measured=None):
@@ -68,21 +72,38 @@ def encode_tracks(items, grid):
         if kind != ANIMATED:
             continue
         quant = QUANTISE_SHARE * tol
+        segments = None
         if rotation:
             mode, code, dropped = quantise_rotations(values, quant)
-            decoded = rotation_from_three(code.values(), dropped)
+            if mode != PER_KEY:
+                signed = values * np.sign(values[:, mode])[:, None]
+                segments = _segmented(signed[:, OTHERS[mode]], code)
+            three = code.values() if segments is None else segments.values
+            decoded = rotation_from_three(three, dropped)
         else:
             mode, dropped = 0, None
             code = quantise_vectors(values, 2 * quant / np.sqrt(3))
-            decoded = code.values()
+            segments = _segmented(values, code)
+            decoded = code.values() if segments is None else segments.values
         animated.append((values, decoded, tol, rotation))
-        codes.append((i, mode, code, dropped))
-    for keys, (i, mode, code, dropped) in zip(_reduce_groups(grid, animated), codes):
+        codes.append((i, mode, code, dropped, segments))
+    for keys, (i, mode, code, dropped, segments) in zip(_reduce_groups(grid, animated), codes):
         joint, channel = items[i][:2]
+        stored = code.codes if segments is None else segments.codes
         out[i] = EncodedTrack(joint, channel, keys=keys, mode=mode,
-                              code=VectorCode(code.lo, code.ext, code.bits, code.codes[keys]),
-                              dropped=None if dropped is None else dropped[keys])
+                              code=VectorCode(code.lo, code.ext, code.bits, stored[keys]),
+                              dropped=None if dropped is None else dropped[keys],
+                              segments=segments)
     return out
+
+
+def _segmented(values, code):
+    """The track's :class:`SegmentCode` when segment ranges take fewer bits at every frame
+    (by more than the segment headers), else None."""
+    segments = segment_vectors(values, code)
+    if segments is None or segments.cost >= SEGMENT_GAIN * segments.plain:
+        return None
+    return segments
 
 
 def gltf_values(values, rotation):

@@ -36,7 +36,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .bits import MAX_FIELD_BITS, pack
-from .quantise import PER_KEY, VectorCode, unit_range_codes, unit_range_values
+from .quantise import (PER_KEY, SEGMENT, SEGMENT_HEADER_BITS, VectorCode, unit_range_codes,
+                       unit_range_values)
 
 __all__ = ["CHANNEL_CODES", "EncodedTrack", "ClipLayout", "write_clip", "read_clip",
            "LayoutError", "ByteReader", "varint"]
@@ -63,6 +64,8 @@ class EncodedTrack:
     mode: int = 0
     code: VectorCode = None
     dropped: np.ndarray = None
+    segments: object = None     # SegmentCode when segmented (writing), the used segments'
+    #                             (index, a, b, bits) arrays when read
 
 
 @dataclass
@@ -99,6 +102,11 @@ def varint(n):
             out.append(byte)
             return bytes(out)
 
+
+#: Bit of a track's code byte: its values are quantised per segment of frames.
+SEGMENTED = 32
+_HEADER_AT = np.array([0, 8, 16, 24, 32, 40, 48, 53, 58])
+_HEADER_WIDTHS = np.array([8, 8, 8, 8, 8, 8, 5, 5, 5])
 
 #: Key-frame code D meaning "a bit per frame" (1: a key) instead of steps.
 MASK = 255
@@ -138,7 +146,8 @@ def write_clip(layout):
         keys = np.asarray(tr.keys, dtype=np.int64)
         steps = np.diff(keys)
         dbits = key_code(keys, count)[0]
-        out += varint(tr.joint) + bytes([CHANNEL_CODES[tr.channel] | (tr.mode << 2)])
+        segmented = SEGMENTED if tr.segments is not None else 0
+        out += varint(tr.joint) + bytes([CHANNEL_CODES[tr.channel] | (tr.mode << 2) | segmented])
         out += varint(len(keys)) + bytes([dbits])
         if tr.mode == PER_KEY:
             out += bytes([int(tr.code.bits[0])])
@@ -161,6 +170,16 @@ def write_clip(layout):
     for tr in layout.animated:
         k = len(tr.keys)
         bits = np.asarray(tr.code.bits, dtype=np.int64)
+        if tr.segments is not None:
+            seg = tr.segments
+            which = np.asarray(tr.keys) // SEGMENT
+            used = np.unique(which)
+            head = np.column_stack([seg.a[used], seg.b[used], seg.bits[used]])
+            fields.append(head.astype(np.uint64).reshape(-1))
+            widths.append(np.tile(np.r_[8, 8, 8, 8, 8, 8, 5, 5, 5], len(used)))
+            fields.append(np.asarray(tr.code.codes, dtype=np.uint64).reshape(-1))
+            widths.append(np.asarray(seg.bits, dtype=np.int64)[which].reshape(-1))
+            continue
         if tr.mode == PER_KEY:
             per = np.column_stack([np.asarray(tr.dropped, dtype=np.uint64), tr.code.codes])
             w = np.r_[2, bits]
@@ -262,8 +281,9 @@ def read_clip(blob, num_joints):
     for _ in range(r.varint("animated track count", size)):
         joint = r.varint("joint index", num_joints - 1)
         code = r.u8("channel")
-        channel, mode = CHANNEL_NAMES.get(code & 3), code >> 2
-        if channel is None or mode > PER_KEY or (channel != "rotation" and mode):
+        channel, mode, segmented = CHANNEL_NAMES.get(code & 3), (code >> 2) & 7, code & SEGMENTED
+        if (channel is None or mode > PER_KEY or (channel != "rotation" and mode)
+                or code > 63 or (segmented and mode == PER_KEY)):
             raise LayoutError(f"clip {name!r}: unknown track code {code}")
         keys = r.varint("key count", count)
         dbits = r.u8("key step bits")
@@ -286,7 +306,8 @@ def read_clip(blob, num_joints):
                                                  and np.all(np.isfinite(ext))):
             raise LayoutError(f"clip {name!r}: a track's range or bits are not valid")
         animated.append(EncodedTrack(joint, channel, keys=keys, mode=mode,
-                                     code=VectorCode(lo, ext, np.asarray(bits), None)))
+                                     code=VectorCode(lo, ext, np.asarray(bits), None),
+                                     segments=True if segmented else None))
         dbits_all.append(dbits)
     words = r.varint("bit stream length", size // 4)
     stream = bytes(r.take(words * 4, "bit stream"))
@@ -305,15 +326,10 @@ def _key_frames(layout, stream, dbits_all):
     need = 0
     for tr, dbits in zip(layout.animated, dbits_all):
         need += count if dbits == MASK else (tr.keys - 1) * dbits
-    offsets = []
-    value_bits = need
-    for tr in layout.animated:
-        stride = int(np.sum(tr.code.bits)) + (2 if tr.mode == PER_KEY else 0)
-        offsets.append(value_bits)
-        value_bits += tr.keys * stride
-    if value_bits > len(stream) * 8:
-        raise LayoutError(f"clip {layout.name!r}: the bit stream holds {len(stream) * 8} bits, "
-                          f"its tracks need {value_bits}")
+    total = len(stream) * 8
+    if need > total:
+        raise LayoutError(f"clip {layout.name!r}: the bit stream holds {total} bits, its key "
+                          f"frames need {need}")
     words = words_of(stream)
     at = 0
     for tr, dbits in zip(layout.animated, dbits_all):
@@ -336,4 +352,34 @@ def _key_frames(layout, stream, dbits_all):
             raise LayoutError(f"clip {layout.name!r}: key frames of a track do not run from "
                               f"the first frame to the last")
         tr.keys = keys
+    return _value_offsets(layout, words, need, total)
+
+
+def _value_offsets(layout, words, at, total):
+    """Each animated track's bit offset of its first key; reads a segmented track's segment
+    headers into ``track.segments`` = (used segment indices, a, b, bits), each checked."""
+    from .bits import read_fields
+    offsets = []
+    for tr in layout.animated:
+        if tr.segments is not None:
+            which = tr.keys // SEGMENT
+            used = np.unique(which)
+            if at + len(used) * SEGMENT_HEADER_BITS > total:
+                raise LayoutError(f"clip {layout.name!r}: the bit stream ends in a track's "
+                                  "segment headers")
+            pos = at + (np.arange(len(used)) * SEGMENT_HEADER_BITS)[:, None] + _HEADER_AT
+            head = read_fields(words, pos, _HEADER_WIDTHS).astype(np.int64)
+            a, b, bits = head[:, 0:3], head[:, 3:6], head[:, 6:9]
+            if np.any(b < a):
+                raise LayoutError(f"clip {layout.name!r}: a segment's range ends are reversed")
+            tr.segments = (used, a, b, bits)
+            at += len(used) * SEGMENT_HEADER_BITS
+            offsets.append(at)
+            at += int(bits[np.searchsorted(used, which)].sum())
+        else:
+            offsets.append(at)
+            at += len(tr.keys) * (int(np.sum(tr.code.bits)) + (2 if tr.mode == PER_KEY else 0))
+        if at > total:
+            raise LayoutError(f"clip {layout.name!r}: the bit stream holds {total} bits, its "
+                              f"tracks need at least {at}")
     return offsets

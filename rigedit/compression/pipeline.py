@@ -26,7 +26,7 @@ from .error import ErrorMeter
 from .kernels import load
 from .frames import COLUMNS, frame_times
 from .layout import ClipLayout, grid_times, key_code, write_clip
-from .quantise import PER_KEY
+from .quantise import PER_KEY, SEGMENT, SEGMENT_HEADER_BITS
 from .report import RAW_BYTES_PER_JOINT_FRAME, ClipRow, CompressionReport
 from .virtual import DEFAULT_SHELL, check_shell, shell_distances
 
@@ -88,8 +88,13 @@ def _kinds(layout, size):
     frames = len(layout.times)
     for tr in layout.animated:
         k = len(tr.keys)
-        stride = int(np.sum(tr.code.bits)) + (2 if tr.mode == PER_KEY else 0)
-        kinds[tr.channel] += k * stride / 8
+        if tr.segments is not None:   # read back: (used segments, a, b, bits)
+            used, _, _, bits = tr.segments
+            which = np.searchsorted(used, tr.keys // SEGMENT)
+            kinds[tr.channel] += (bits[which].sum() + len(used) * SEGMENT_HEADER_BITS) / 8
+        else:
+            stride = int(np.sum(tr.code.bits)) + (2 if tr.mode == PER_KEY else 0)
+            kinds[tr.channel] += k * stride / 8
         kinds["times"] += key_code(tr.keys, frames)[1] / 8
     kinds = {k: int(round(v)) for k, v in kinds.items()}
     kinds["header"] = size - sum(v for k, v in kinds.items() if k != "header")

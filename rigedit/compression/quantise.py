@@ -27,7 +27,8 @@ import numpy as np
 
 from .bits import MAX_FIELD_BITS
 
-__all__ = ["FIXED_MIN", "PER_KEY", "VectorCode", "quantise_vectors", "dequantise_vectors",
+__all__ = ["FIXED_MIN", "PER_KEY", "SEGMENT", "SEGMENT_HEADER_BITS", "VectorCode",
+           "SegmentCode", "segment_vectors", "segment_range", "quantise_vectors", "dequantise_vectors",
            "quantise_rotations", "rotation_from_three", "OTHERS"]
 
 #: Smallest magnitude the dropped component may have in every key of a ``fixed`` track: the
@@ -42,12 +43,13 @@ _HALF_SQRT2 = np.sqrt(0.5)
 
 class VectorCode:
     """Quantised components of one track: ``lo`` and ``ext`` (3,) float32, ``bits`` (3,)
-    int, ``codes`` (K, 3) uint64. ``values()`` gives what a decoder reads back."""
+    int, ``codes`` (K, 3) uint64, ``step`` the precision asked for. ``values()`` gives what a
+    decoder reads back."""
 
-    __slots__ = ("lo", "ext", "bits", "codes")
+    __slots__ = ("lo", "ext", "bits", "codes", "step")
 
-    def __init__(self, lo, ext, bits, codes):
-        self.lo, self.ext, self.bits, self.codes = lo, ext, bits, codes
+    def __init__(self, lo, ext, bits, codes, step=None):
+        self.lo, self.ext, self.bits, self.codes, self.step = lo, ext, bits, codes, step
 
     def values(self):
         return dequantise_vectors(self.lo, self.ext, self.bits, self.codes)
@@ -124,7 +126,7 @@ def quantise_vectors(values, step, unit=False):
     with np.errstate(divide="ignore", invalid="ignore"):
         norm = np.where(levels > 0, (values - lo) / np.where(ext > 0, ext, 1.0), 0.0)
     codes = np.clip(np.rint(norm * levels), 0, levels).astype(np.uint64)
-    return VectorCode(lo, ext, bits, codes)
+    return VectorCode(lo, ext, bits, codes, step)
 
 
 def rotation_from_three(three, dropped):
@@ -184,3 +186,60 @@ def quantise_rotations(quats, tol):
     codes = np.clip(np.rint((three - lo.astype(np.float64)) / ext.astype(np.float64) * levels),
                     0, levels).astype(np.uint64)
     return PER_KEY, VectorCode(lo, ext, np.full(3, bits), codes), dropped
+
+
+#: Frames of a segment: a segmented track gives each run of this many frames its own range,
+#: a part of the track's range in 1/255ths (ACL's segments).
+SEGMENT = 16
+#: Bits of a segment's header: per component its range's two ends (8 bits each, in 255ths
+#: of the track's range) and its bits (5 bits).
+SEGMENT_HEADER_BITS = 3 * (8 + 8 + 5)
+
+
+def segment_range(lo, ext, a, b):
+    """A segment's ``(lo, ext)`` float64 from the track's range and the segment's ends in
+    255ths (the same arithmetic in the encoder and the decoder)."""
+    lo, ext = np.asarray(lo, dtype=np.float64), np.asarray(ext, dtype=np.float64)
+    unit = ext / 255.0
+    return lo + np.asarray(a, dtype=np.float64) * unit, \
+        (np.asarray(b, dtype=np.float64) - a) * unit
+
+
+class SegmentCode:
+    """A segmented track: per frame segment (G of them) the range ends ``a``, ``b`` (G, 3)
+    in 255ths of the track's range and ``bits`` (G, 3); ``codes`` (F, 3) relative to their
+    frame's segment; ``values`` (F, 3) decoded; ``cost`` / ``plain``: bits of every frame
+    segmented / in the track's range."""
+
+    __slots__ = ("a", "b", "bits", "codes", "values", "cost", "plain")
+
+
+def segment_vectors(values, code):
+    """Quantise (F, 3) values per :data:`SEGMENT`-frame segment within the track's range
+    ``code`` (a :class:`VectorCode` of the same values, at the same step); None when a
+    component needs more than 31 bits."""
+    values = np.asarray(values, dtype=np.float64)
+    f = len(values)
+    lo, ext = np.asarray(code.lo, np.float64), np.asarray(code.ext, np.float64)
+    starts = np.arange(0, f, SEGMENT)
+    norm = (values - lo) / np.where(ext > 0, ext, 1.0)
+    a = np.clip(np.floor(np.minimum.reduceat(norm, starts, axis=0) * 255), 0, 255)
+    b = np.clip(np.ceil(np.maximum.reduceat(norm, starts, axis=0) * 255), 0, 255)
+    a = np.where(ext > 0, a, 0)
+    b = np.where(ext > 0, np.maximum(b, a), 0)
+    seg_lo, seg_ext = segment_range(lo, ext, a, b)
+    bits = bits_for(seg_ext, code.step)
+    if bits.max(initial=0) > 31:
+        return None
+    which = np.arange(f) // SEGMENT
+    levels = (np.left_shift(1, bits) - 1).astype(np.float64)[which]
+    span = seg_ext[which]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        normed = np.where(levels > 0, (values - seg_lo[which]) / np.where(span > 0, span, 1), 0)
+    out = SegmentCode()
+    out.a, out.b, out.bits = a.astype(np.uint8), b.astype(np.uint8), bits
+    out.codes = np.clip(np.rint(normed * levels), 0, levels).astype(np.uint64)
+    out.values = dequantise_vectors(seg_lo[which], seg_ext[which], bits[which], out.codes)
+    out.cost = int(bits[which].sum()) + len(starts) * SEGMENT_HEADER_BITS
+    out.plain = f * int(np.sum(code.bits))
+    return out
