@@ -12,7 +12,8 @@ time grid             uniform: float64 start, float64 period (frame i at start +
 constant tracks       varint C, then C x (varint joint, uint8 channel, 3 or 4 float32)
 animated tracks       varint A, then A track headers:
                       varint joint; uint8 channel (bits 0-1: 0 translation, 1 rotation,
-                      2 scale) | rotation mode << 2 (0-3 fixed dropped component, 4 per key);
+                      2 scale) | rotation mode << 2 (0-3 fixed dropped component, 4 per key)
+                      | 32 when segmented (its values per 16-frame segment);
                       varint K (keys, 2..F); uint8 D (bits per key-frame step, 0: every
                       frame is a key, 255: a bit per frame); per-key rotation: uint8 B (bits of all three
                       components); fixed rotation: 3 uint8 bits, 3 uint16 lo, 3 uint16
@@ -21,8 +22,11 @@ animated tracks       varint A, then A track headers:
 bit stream            varint n words, n uint32 words: first every animated track's key
                       frames (D = 255: F bits, 1 where a frame is a key; else K - 1 steps
                       of D bits each, the first key frame 0), then every
-                      animated track's K keys, each [2 bits dropped component, per-key
-                      rotations only] + 3 components of their bits
+                      animated track's values: a segmented track's 63-bit header per
+                      segment holding a key (3 x 8-bit a, 3 x 8-bit b, 3 x 5-bit bits: the
+                      range lo + a ext / 255, (b - a) ext / 255), then its K keys, each
+                      [2 bits dropped component, per-key rotations only] + 3 components
+                      in their (segment's) bits
 ====================  ======================================================================
 
 A component of b bits is ``lo + code * extent / (2^b - 1)``, of 0 bits ``lo + extent / 2``.
