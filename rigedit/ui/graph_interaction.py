@@ -39,6 +39,8 @@ __all__ = ["GraphInteraction", "PICK_PX"]
 
 #: How near (pixels) a click must be to a key or handle to grab it.
 PICK_PX = 6.0
+#: A handle nearer its key than this (pixels) is under the key and not grabbed.
+HANDLE_MIN_PX = 4.0
 #: A press must move this far (pixels) before it is a drag rather than a click.
 DRAG_PX = 3
 WHEEL_ZOOM = 1.15
@@ -259,14 +261,17 @@ class GraphInteraction(QtCore.QObject):
 
     def handle_at(self, pos, radius=PICK_PX):
         """The drawn handle nearest to ``pos``: ``(ChannelId, index, side, curve)`` or None
-        (side ``"left"`` or ``"right"``)."""
+        (side ``"left"`` or ``"right"``). A handle closer than :data:`HANDLE_MIN_PX` to its
+        key is not grabbed: it lies under the key (dense keys), which the click means."""
         best, tr = None, self.view.transform
         for c in self.view.visible_channels():
             sides = self.view.handle_sides(c)
             if sides is None:
                 continue
-            _, handles, index, side = sides
-            d = np.hypot(tr.x_of(handles[:, 0]) - pos.x(), tr.y_of(handles[:, 1]) - pos.y())
+            keys, handles, index, side = sides
+            hx, hy = tr.x_of(handles[:, 0]), tr.y_of(handles[:, 1])
+            d = np.hypot(hx - pos.x(), hy - pos.y())
+            d[np.hypot(hx - tr.x_of(keys[:, 0]), hy - tr.y_of(keys[:, 1])) < HANDLE_MIN_PX] = np.inf
             i = int(np.argmin(d))
             if d[i] <= radius and (best is None or d[i] < best[0]):
                 best = (d[i], c.id, int(index[i]), ("left", "right")[side[i]], c.curve)

@@ -445,3 +445,14 @@ def test_another_clip_drops_the_key_selection_and_frames_its_keys(window):
     assert view.duration == walk and view.transform.t1 >= walk     # the walk framed
     d.set_current_clip("sway")
     assert view.selected == {} and view.duration == 1.0
+
+
+def test_a_handle_hidden_under_its_key_leaves_the_click_to_the_key(window):
+    d, view = window.document, _only(window, T_Y)
+    QTest.mouseClick(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, _key_pos(view, T_Y, 1))
+    window.graph_editor.set_interpolation("bezier")
+    view.transform.zoom(1 / 40.0, time=True, value=False)   # handles ~2 px from the key
+    view.update_view()
+    start = _key_pos(view, T_Y, 1)
+    _drag(view, start, start + QtCore.QPoint(0, -30))
+    assert d.undo_stack.undo_label == "Move keys"
