@@ -138,3 +138,21 @@ def test_compress_keeps_its_bound_and_reports_ratio_and_error(tmp_path):
     assert 0 < q["max error (cm)"] <= 0.05 and q["ratio"] > 1
     assert q["compressed (KB)"] < q["raw (KB)"]
     assert len(rigedit.load_rig(tmp_path / task["outputs"][0]).clips) == 1
+
+
+@pytest.mark.slow
+def test_render_writes_a_video_and_its_contact_sheet(tmp_path):
+    import imageio.v3 as iio
+
+    from rigedit.batch.jobs import run_task
+
+    settings = check_options("render", {"clip": "wave", "size": "64x48", "fps": 4.0,
+                                        "video": "gif"})
+    (task,) = plan("render", ["humanoid"], tmp_path, settings)
+    entry = run_task(task)
+    assert entry["status"] == "ok", entry["error"]
+    video, sheet = (tmp_path / o for o in entry["outputs"])
+    frames = iio.imread(video, index=None)
+    assert 6 <= entry["quality"]["frames"] and frames.shape[1:3] == (48, 64)
+    assert iio.imread(sheet).shape[:2] == (2 * 48, 3 * 64)
+    assert entry["thumbnail"] == entry["outputs"][1]
