@@ -44,9 +44,10 @@ def setup(rig_name, clip_name, max_error_cm):
         warnings.simplefilter("ignore")
         rig = rigedit.load_rig(rig_name)
     doc = Document(rig)
-    path = Path(tempfile.mkdtemp(prefix="bench-rgc-")) / "clip.rgc"
-    report = export_compressed(doc, path, max_error_cm / 100, clips=[clip_name])
-    packed = rigedit.load_rig(path).clips[clip_name]
+    with tempfile.TemporaryDirectory(prefix="bench-rgc-") as folder:
+        path = Path(folder) / "clip.rgc"
+        report = export_compressed(doc, path, max_error_cm / 100, clips=[clip_name])
+        packed = rigedit.load_rig(path).clips[clip_name]   # read whole: the file can go
     plotter = pv.Plotter(off_screen=True, window_size=(1280, 720))
     scene = RigScene(plotter, rig)   # built on the plain clips (it reads their tracks)
     scene.view("front", angle=35)
