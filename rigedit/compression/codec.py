@@ -151,6 +151,17 @@ class ClipDecoder:
         self.compiled = kernels() if on else None
         return self.compiled is not None
 
+    def pose_arrays(self, t, row, translation, rotation, scale):
+        """One pose at clip time ``t`` into a pose's arrays ((J, 3), (J, 4), (J, 3), float64,
+        C-contiguous); ``row`` (J * 10,) a scratch buffer."""
+        if self.compiled is not None:
+            self.compiled.pose_into(float(t), self.itab, self.sitab, self.sftab, self.key_seg,
+                                    self.key_times, self.words, self.base, row, translation,
+                                    rotation, scale)
+            return
+        grid = self.pose_into(t, row).reshape(-1, 10)
+        translation[:], rotation[:], scale[:] = grid[:, :3], grid[:, 3:7], grid[:, 7:]
+
     def pose_into(self, t, out):
         """One pose at clip time ``t`` into ``out`` (J * 10,) float64."""
         if self.compiled is not None:

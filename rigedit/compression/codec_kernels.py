@@ -107,3 +107,18 @@ def poses_at(times, itab, sitab, sftab, key_seg, key_times, words, base, out):
     for n in range(times.shape[0]):
         out[n, :] = base
         _pose(times[n], itab, sitab, sftab, key_seg, key_times, words, _OTHERS, out[n], a, b)
+
+
+@numba.njit(cache=True)
+def pose_into(t, itab, sitab, sftab, key_seg, key_times, words, base, row, translation,
+              rotation, scale):
+    """:func:`pose_at` into ``row``, then into a pose's own (J, 3), (J, 4), (J, 3) arrays in
+    the same call (what ``CompressedClip.sample`` needs)."""
+    pose_at(t, itab, sitab, sftab, key_seg, key_times, words, base, row)
+    for j in range(translation.shape[0]):
+        o = j * 10
+        for m in range(3):
+            translation[j, m] = row[o + m]
+            scale[j, m] = row[o + 7 + m]
+        for m in range(4):
+            rotation[j, m] = row[o + 3 + m]

@@ -97,8 +97,8 @@ class CompressedClip(_Sampled):
         if self._first:   # playback: worth the compiled decoder (imported once, ~1 s)
             self._first = False
             self.decoder.use_kernels()
-        self.decoder.pose_into(self.local_time(t), self._row)
-        pose.set_array(self._row.reshape(-1, 10))
+        self.decoder.pose_arrays(self.local_time(t), self._row, pose.translation,
+                                 pose.rotation, pose.scale)
         return pose
 
     def sample_many(self, times):
