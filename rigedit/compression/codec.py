@@ -89,6 +89,10 @@ class ClipDecoder:
             self.seg_bits]).astype(np.int64))
         self.sftab = np.ascontiguousarray(np.column_stack([self.seg_lo, self.seg_scale]))
         self.compiled = None
+        # the compiled single-pose path's key cache: the key each track decoded last, and
+        # that key's and the next one's values (keys never change, so it never goes stale)
+        self._cache = (np.full(self.count, -1, dtype=np.int64), np.zeros((self.count, 4)),
+                       np.zeros((self.count, 4)))
 
     def _segment_tables(self, tracks, offsets, lead):
         """Per segment of stored keys (a whole track when it is not segmented): bit offset of
@@ -157,7 +161,7 @@ class ClipDecoder:
         if self.compiled is not None:
             self.compiled.pose_into(float(t), self.itab, self.sitab, self.sftab, self.key_seg,
                                     self.key_times, self.words, self.base, row, translation,
-                                    rotation, scale)
+                                    rotation, scale, *self._cache)
             return
         grid = self.pose_into(t, row).reshape(-1, 10)
         translation[:], rotation[:], scale[:] = grid[:, :3], grid[:, 3:7], grid[:, 7:]

@@ -54,7 +54,9 @@ def _decode_key(words, itab, sitab, sftab, key_seg, k, gkey, others, q):
 
 
 @numba.njit(cache=True)
-def _pose(t, itab, sitab, sftab, key_seg, key_times, words, others, out, a, b):
+def _pose(t, itab, sitab, sftab, key_seg, key_times, words, others, out, a, b, last, qa, qb):
+    """One pose into ``out``; ``last`` (T,) the key each track decoded last and ``qa``, ``qb``
+    (T, 4) its two keys, reused when ``t`` falls between the same keys (a batch of times)."""
     for k in range(itab.shape[0]):
         lo = itab[k, 0]
         hi = lo + itab[k, 1] - 1
@@ -71,8 +73,13 @@ def _pose(t, itab, sitab, sftab, key_seg, key_times, words, others, out, a, b):
                     hi = mid
             i = lo
             u = (t - key_times[i]) / (key_times[i + 1] - key_times[i])
-        _decode_key(words, itab, sitab, sftab, key_seg, k, i, others, a)
-        _decode_key(words, itab, sitab, sftab, key_seg, k, i + 1, others, b)
+        if last[k] != i:
+            _decode_key(words, itab, sitab, sftab, key_seg, k, i, others, qa[k])
+            _decode_key(words, itab, sitab, sftab, key_seg, k, i + 1, others, qb[k])
+            last[k] = i
+        for m in range(4):
+            a[m] = qa[k, m]
+            b[m] = qb[k, m]
         col = itab[k, 4]
         if itab[k, 3] == 0:
             for m in range(3):
@@ -96,7 +103,11 @@ def pose_at(t, itab, sitab, sftab, key_seg, key_times, words, base, out):
     out[:] = base
     a = np.empty(4)
     b = np.empty(4)
-    _pose(t, itab, sitab, sftab, key_seg, key_times, words, _OTHERS, out, a, b)
+    t_count = itab.shape[0]
+    last = np.full(t_count, -1, dtype=np.int64)
+    qa = np.zeros((t_count, 4))
+    qb = np.zeros((t_count, 4))
+    _pose(t, itab, sitab, sftab, key_seg, key_times, words, _OTHERS, out, a, b, last, qa, qb)
 
 
 @numba.njit(cache=True)
@@ -104,17 +115,27 @@ def poses_at(times, itab, sitab, sftab, key_seg, key_times, words, base, out):
     """Poses at clip times (N,) into ``out`` (N, J * 10) float64."""
     a = np.empty(4)
     b = np.empty(4)
+    t_count = itab.shape[0]
+    last = np.full(t_count, -1, dtype=np.int64)
+    qa = np.zeros((t_count, 4))
+    qb = np.zeros((t_count, 4))
     for n in range(times.shape[0]):
         out[n, :] = base
-        _pose(times[n], itab, sitab, sftab, key_seg, key_times, words, _OTHERS, out[n], a, b)
+        _pose(times[n], itab, sitab, sftab, key_seg, key_times, words, _OTHERS, out[n], a, b,
+              last, qa, qb)
 
 
 @numba.njit(cache=True)
 def pose_into(t, itab, sitab, sftab, key_seg, key_times, words, base, row, translation,
-              rotation, scale):
+              rotation, scale, last, qa, qb):
     """:func:`pose_at` into ``row``, then into a pose's own (J, 3), (J, 4), (J, 3) arrays in
-    the same call (what ``CompressedClip.sample`` needs)."""
-    pose_at(t, itab, sitab, sftab, key_seg, key_times, words, base, row)
+    the same call (what ``CompressedClip.sample`` needs); ``last``, ``qa``, ``qb`` the
+    caller's key cache (see :func:`_pose`), kept across calls: playback frame after frame
+    between the same two keys decodes them once."""
+    row[:] = base
+    a = np.empty(4)
+    b = np.empty(4)
+    _pose(t, itab, sitab, sftab, key_seg, key_times, words, _OTHERS, row, a, b, last, qa, qb)
     for j in range(translation.shape[0]):
         o = j * 10
         for m in range(3):
