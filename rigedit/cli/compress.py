@@ -121,7 +121,11 @@ def cmd_compress(args):
     check_compression(args, args.output)
     rig = load(args.rig, scale=args.scale)
     names = clip_names(rig, args.clip)
-    for line in compress_and_write(rig, names, args.output, args):
+    from .output import warning_lines
+
+    with warning_lines():   # a clip written with float32 rotations: one line
+        lines = compress_and_write(rig, names, args.output, args)
+    for line in lines:
         print(line)
     print(f"wrote {Path(args.output).resolve()}: clips: {' '.join(names)}")
     return 0

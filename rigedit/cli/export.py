@@ -39,7 +39,11 @@ def cmd_export(args):
     rig = load(args.rig, scale=args.scale)
     if args.compress:
         names = clip_names(rig, args.clip)
-        for line in compress_and_write(rig, names, args.output, args):
+        from .output import warning_lines
+
+        with warning_lines():
+            lines = compress_and_write(rig, names, args.output, args)
+        for line in lines:
             print(line)
         print(f"wrote {Path(args.output).resolve()}: {len(rig.skeleton)} joints, "
               f"{len(rig.vertices)} vertices, compressed clips: {' '.join(names)}")

@@ -14,7 +14,10 @@ within the int16 step where keys are close, not where a reduced track's keys are
 2. a clip over the bound is compressed again with its bound scaled by what it missed by
    (``bound * 0.9 * max_error / measured``, at most halved per try), at most
    :data:`ATTEMPTS` times;
-3. the file is written (:mod:`rigedit.io.gltf_write_compact`) and the report's sizes are the
+3. a clip that no compression holds on the int16 grid (a long chain where the grid's step at
+   the root alone moves the hands past the bound) is written with its own keys and float32
+   rotations, said in one warning;
+4. the file is written (:mod:`rigedit.io.gltf_write_compact`) and the report's sizes are the
    bytes of its animation data as stored.
 
 The report is a :class:`rigedit.compression.CompressionReport` whose errors are those of the
@@ -23,6 +26,7 @@ glTF as read: its ``max_error`` never exceeds the bound.
 from __future__ import annotations
 
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -55,13 +59,15 @@ def slerp_keys(clip):
     return Clip(clip.name, clip.skeleton, tracks, clip.duration, clip.loop)
 
 
-def as_read(clip):
+def as_read(clip, float_rotations=False):
     """``clip`` as rigedit's (or any spec-following) glTF reader gets it back from the compact
     writer: float32 key times as the writer rounds them, and the output rows it stores
-    decoded (:func:`~rigedit.io.gltf_write_compact.decoded_rows`)."""
+    decoded (:func:`~rigedit.io.gltf_write_compact.decoded_rows`; all float32 with
+    ``float_rotations``)."""
     tracks = {}
     for key, tr in clip.tracks.items():
-        kind, rows = decoded_rows(tr, is_rest(tr, rest_value(clip.skeleton, *key)))
+        kind, rows = decoded_rows(tr, float_rotations or
+                                  is_rest(tr, rest_value(clip.skeleton, *key)))
         times = _float32_times(tr.times).astype(np.float64)
         tangents, mode = None, _MODES[kind]
         if kind == "CUBICSPLINE":
@@ -74,21 +80,38 @@ def as_read(clip):
 
 
 def _fit_one(skeleton, name, clip, max_error, shell, mesh):
-    """``(keys to write, (F, J) errors as read, attempts)`` of one clip."""
+    """``(keys to write, (F, J) errors as read, attempts, float rotations)`` of one clip."""
     meter = ErrorMeter(skeleton, clip, frame_times(clip), shell, mesh)
     bound = max_error
     for attempt in range(1, ATTEMPTS + 1):
-        result = compress_clips(skeleton, {name: clip}, max_error=bound, shell=shell,
-                                mesh=mesh, target="gltf")
+        try:
+            result = compress_clips(skeleton, {name: clip}, max_error=bound, shell=shell,
+                                    mesh=mesh, target="gltf")
+        except ValueError:   # the int16 grid alone errs more than the bound
+            return _float_fallback(meter, name, clip, max_error, attempt)
         keys = slerp_keys(result.clips[name].to_clip())
         err = meter.error(as_read(keys))
         worst = float(err.max())
         if worst <= max_error:
-            return keys, err, attempt
+            return keys, err, attempt, False
         # what it missed by, at most halved per try (the miss is not linear in the bound)
         bound *= max(0.5, min(0.9 * max_error / worst, 0.9))
-    raise ValueError(f"clip {name!r}: cannot hold max_error {max_error:g} m in glTF (still "
-                     f"{worst:.3g} m after {ATTEMPTS} compressions)")
+    return _float_fallback(meter, name, clip, max_error, ATTEMPTS)
+
+
+def _float_fallback(meter, name, clip, max_error, attempts):
+    """The clip's own keys with float32 rotations, when no compression holds the bound on the
+    int16 grid (a long chain: the grid's step at the root moves the hands): said in one
+    warning; ``ValueError`` if even that errs more than the bound."""
+    keys = slerp_keys(clip)
+    err = meter.error(as_read(keys, float_rotations=True))
+    if err.max() > max_error:
+        raise ValueError(f"clip {name!r}: cannot hold max_error {max_error:g} m in glTF (its "
+                         f"own keys with float32 rotations err {err.max():.3g} m)")
+    warnings.warn(f"clip {name!r}: glTF's int16 rotations alone err more than "
+                  f"{max_error * 100:g} cm on this skeleton: its keys are written uncompressed "
+                  "with float32 rotations (rigedit's own format compresses it)")
+    return keys, err, attempts, True
 
 
 def fit_clips(skeleton, clips, max_error=1e-4, shell=0.03, mesh=None):
@@ -108,17 +131,23 @@ def fit_clips(skeleton, clips, max_error=1e-4, shell=0.03, mesh=None):
         Reduced keys to write (SLERP rotations).
     report : CompressionReport
         Errors as read; sizes still 0 (:func:`save_gltf_compressed_rig` fills them).
+    float_clips : set[str]
+        Clips whose int16 rotations alone err more than the bound: their own keys, to be
+        written with float32 rotations (one warning each).
     """
     start = time.perf_counter()
     report = CompressionReport(max_error, shell, "gltf")
-    keys, attempts = {}, {}
+    keys, attempts, floats = {}, {}, set()
     for name, clip in clips.items():
-        keys[name], _, attempts[name] = _fit_one(skeleton, name, clip, max_error, shell, mesh)
+        keys[name], _, attempts[name], flt = _fit_one(skeleton, name, clip, max_error, shell,
+                                                      mesh)
+        if flt:
+            floats.add(name)
     keys = same_channels(keys)   # what the writer writes: measured again as read
     errors = []
     for name, clip in clips.items():
         err = ErrorMeter(skeleton, clip, frame_times(clip), shell, mesh).error(
-            as_read(keys[name]))
+            as_read(keys[name], float_rotations=name in floats))
         if err.max() > max_error:
             raise ValueError(f"clip {name!r}: {err.max():.3g} m over max_error {max_error:g} m "
                              "once every clip keys the same channels")
@@ -133,7 +162,7 @@ def fit_clips(skeleton, clips, max_error=1e-4, shell=0.03, mesh=None):
                                               "omitted": max(len(clip.tracks) - len(tracks),
                                                              0)},
             sum(len(tr) for tr in tracks if len(tr) > 1), attempts[name]))
-    return keys, report.finish(errors, time.perf_counter() - start)
+    return keys, report.finish(errors, time.perf_counter() - start), floats
 
 
 def save_gltf_compressed_rig(rig, path, clips=None, max_error=1e-4, shell=0.03, mesh=None,
@@ -159,9 +188,9 @@ def save_gltf_compressed_rig(rig, path, clips=None, max_error=1e-4, shell=0.03, 
         if unknown is not None:
             raise ValueError(f"unknown clip {unknown!r} (the rig has "
                              f"{', '.join(rig.clips) or 'none'})")
-        keys, report = fit_clips(rig.skeleton, {n: rig.clips[n] for n in names}, max_error,
-                                 shell, mesh)
-        compact = CompactAnimations(keys, meshopt=meshopt)
+        keys, report, floats = fit_clips(rig.skeleton, {n: rig.clips[n] for n in names},
+                                         max_error, shell, mesh)
+        compact = CompactAnimations(keys, meshopt=meshopt, float_clips=floats)
     except ValueError as exc:
         raise RigFileError(path, str(exc)) from None
     save_gltf(rig, path, compact=compact)

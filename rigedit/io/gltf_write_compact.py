@@ -150,14 +150,18 @@ class CompactAnimations:
         Clip name -> plain clip of reduced keys (its skeleton's joint names are the rig's).
     meshopt : bool
         Compress the buffer views with ``EXT_meshopt_compression`` too.
+    float_clips : iterable of str
+        Clips whose rotations are written float32 (where the int16 grid alone errs more than
+        the bound: :mod:`rigedit.io.gltf_compress`).
     """
 
-    def __init__(self, clips, meshopt=False):
+    def __init__(self, clips, meshopt=False, float_clips=()):
         if meshopt and not meshopt_available():
             raise ValueError("--meshopt needs the meshopt package (pip install "
                              "'rigedit[meshopt]')")
         self.clips = dict(clips)
         self.meshopt = bool(meshopt)
+        self.float_clips = set(float_clips)
         self._times = {}        # float32 key-time bytes -> accessor index
         self._clip = None       # the clip being written
         self._views = []        # (buffer view, clip name, kind) of the animation data
@@ -218,7 +222,7 @@ class CompactAnimations:
             sk = clip.skeleton
             # a rest key is written float32, exactly (it was never quantised)
             exact = {id(tr) for key, tr in clip.tracks.items()
-                     if is_rest(tr, rest_value(sk, *key))}
+                     if name in self.float_clips or is_rest(tr, rest_value(sk, *key))}
             last = max((tr.times[-1] for tr in clip.tracks.values()), default=0.0)
             holder = None
             if clip.duration > last + 1e-6:

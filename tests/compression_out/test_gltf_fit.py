@@ -17,7 +17,8 @@ def rig():
 
 
 def test_as_read_is_what_the_reader_gets(tmp_path, rig):
-    keys, _ = fit_clips(rig.skeleton, rig.clips, max_error=2e-4)
+    keys, _, floats = fit_clips(rig.skeleton, rig.clips, max_error=2e-4)
+    assert floats == set()
     out = tmp_path / "f.glb"
     save_gltf_compressed_rig(rig, out, max_error=2e-4)
     back = rigedit.load_rig(out)
@@ -43,8 +44,30 @@ def test_a_clip_over_the_bound_as_read_is_compressed_again(monkeypatch, rig):
                     **kw)
 
     monkeypatch.setattr(gltf_compress, "compress_clips", loose_first)
-    keys, report = fit_clips(rig.skeleton, {"walk": rig.clips["walk"]}, max_error=1e-4)
+    keys, report, _ = fit_clips(rig.skeleton, {"walk": rig.clips["walk"]}, max_error=1e-4)
     assert len(calls) >= 2 and calls[1] < calls[0]
     assert report.clips[0].attempts == len(calls)
     err = measure_error(rig.skeleton, rig.clips["walk"], as_read(keys["walk"]))
     assert err.max() <= 1e-4 and report.max_error == pytest.approx(err.max())
+
+
+def test_a_clip_no_compression_holds_is_written_with_float_rotations(tmp_path, monkeypatch,
+                                                                     rig):
+    """Where the glTF target gives up (the int16 grid alone errs more than the bound), the
+    clip's own keys go out with float32 rotations, said in one warning, within the bound."""
+    import pygltflib
+
+    def gives_up(*args, **kw):
+        raise ValueError("clip 'walk': cannot hold max_error (test)")
+
+    monkeypatch.setattr(gltf_compress, "compress_clips", gives_up)
+    out = tmp_path / "f.glb"
+    with pytest.warns(UserWarning, match="'walk'.*float32 rotations"):
+        report = save_gltf_compressed_rig(rig, out, ["walk"], max_error=1e-4)
+    g = pygltflib.GLTF2().load(str(out))
+    rotations = [g.accessors[a.samplers[c.sampler].output] for a in g.animations
+                 for c in a.channels if c.target.path == "rotation"]
+    assert rotations and all(acc.componentType == 5126 for acc in rotations)
+    back = rigedit.load_rig(out)
+    err = measure_error(rig.skeleton, rig.clips["walk"], back.clips["walk"])
+    assert err.max() <= 1e-4 and report.max_error <= 1e-4
