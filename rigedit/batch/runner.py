@@ -162,12 +162,17 @@ def run(job, inputs, out, workers=None, scheduler=None, resume=False, quiet=True
     version = rigedit_version()
     todo = [t for t in tasks if not (resume and manifest.done(t, version))]
     failed = 0
-    if outdir.exists():
-        prepare_outdir(outdir)   # not writable: said before a cluster starts
+    made = not outdir.exists()
+    prepare_outdir(outdir)   # cannot be made or written: said before a cluster starts
     if todo:
-        engine.start()   # a scheduler that does not answer: said before OUTDIR is made
+        try:
+            engine.start()
+        except BaseException:   # a scheduler that does not answer: leave no trace
+            if made:
+                with contextlib.suppress(OSError):
+                    outdir.rmdir()
+            raise
     try:
-        prepare_outdir(outdir)
         if todo:
             failed = _run_tasks(engine, outdir, manifest, todo, quiet)
     finally:   # also when interrupted: the index and the report show what is done
