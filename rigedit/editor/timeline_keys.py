@@ -65,20 +65,30 @@ class KeyEditor:
     def _tolerance(self):
         return 0.5 / self.fps()
 
+    def _refusable(self, edit, *args, **kwargs):
+        """Run a key edit; one it refuses (``ValueError``: a compressed clip, which is read
+        only, or a mode a track cannot take) is shown with ``error`` and changes nothing."""
+        try:
+            return edit(*args, **kwargs)
+        except ValueError as exc:
+            self.error(str(exc))
+            return 0
+
     def insert_key(self, all_joints=False, joints=None, label=None, amend=False):
         """Key the selected joint (every joint when ``all_joints`` or nothing is selected) at
         the current time from the current pose. Creates a clip when there is none."""
         joints = joints if joints is not None else self.scope(all_joints)
-        return keys.set_key(self.document, joints, label=label, amend=amend)
+        return self._refusable(keys.set_key, self.document, joints, label=label, amend=amend)
 
     def delete_key(self, all_joints=False):
         """Delete the selected joint's (or all joints') key at the current time."""
-        return keys.delete_key(self.document, self.scope(all_joints),
+        return self._refusable(keys.delete_key, self.document, self.scope(all_joints),
                                tolerance=self._tolerance())
 
     def move_key(self, old, new, all_joints=False):
         """Move the key at ``old`` seconds to ``new`` (selected joint, or all)."""
-        return keys.move_keys(self.document, {old: new}, self.scope(all_joints))
+        return self._refusable(keys.move_keys, self.document, {old: new},
+                               self.scope(all_joints))
 
     def copy_keys(self, all_joints=False):
         """Copy the selected joint's (or all) values at the current time."""
@@ -88,16 +98,13 @@ class KeyEditor:
 
     def paste_keys(self):
         """Paste copied values as keys at the current time."""
-        return keys.paste_keys(self.document, self.clipboard)
+        return self._refusable(keys.paste_keys, self.document, self.clipboard)
 
     def set_interpolation(self, mode, channel="rotation"):
         """Interpolation of the selected joint's (or all) ``rotation`` or ``vector``
         (translation and scale) tracks; a refused mode is shown, not raised."""
-        try:
-            return keys.set_interpolation(self.document, mode, self.document.selection, channel)
-        except ValueError as exc:
-            self.error(str(exc))
-            return 0
+        return self._refusable(keys.set_interpolation, self.document, mode,
+                               self.document.selection, channel)
 
     # ------------------------------------------------------------------ key drags
     def key_drag_start(self, t, all_joints):
@@ -107,7 +114,8 @@ class KeyEditor:
         if self.document.clip is None:
             return
         self.seek(t)
-        self._drag = keys.KeyDrag(self.document, t, None if all_joints else self.scope(False))
+        self._drag = self._refusable(keys.KeyDrag, self.document, t,
+                                     None if all_joints else self.scope(False)) or None
 
     def key_drag_move(self, t):
         """The dragged key is at ``t``: the clip shows it there (not yet an undo step)."""

@@ -187,3 +187,28 @@ def test_compressed_clips_open_read_only_and_play_their_bits(doc, tmp_path):
     np.testing.assert_allclose(duplicate.sample(0.4).as_array(), clip.sample(0.4).as_array(),
                                atol=1e-6)
     duplicate.set_key("root", "rotation", 0.5, [0, 0, 0, 1])
+
+
+def test_timeline_key_edits_on_a_compressed_clip_are_one_message(doc, tmp_path):
+    """The timeline's key buttons and key drags on a read-only compressed clip: each refusal
+    reaches the error callback (one message), nothing changes and no undo step is made."""
+    from rigedit.editor import files
+    from rigedit.editor.timeline_keys import KeyEditor
+
+    out = tmp_path / "walk.rgc"
+    export_compressed(doc, out, BOUND, clips=["walk"])
+    shown = Document(files.load_rig(out))
+    shown.set_current_clip("walk")
+    before = shown.clip.key_times().copy()
+    messages = []
+    editor = KeyEditor(shown, lambda: 30.0, lambda t: None, lambda: None, messages.append)
+    shown.set_time(float(before[1]))
+    assert editor.insert_key() == 0
+    assert editor.delete_key() == 0
+    assert editor.move_key(float(before[1]), float(before[1]) + 0.1) == 0
+    editor.key_drag_start(float(before[1]), all_joints=True)
+    editor.key_drag_move(float(before[1]) + 0.1)
+    editor.key_drag_end()
+    assert len(messages) == 4 and all("compressed" in m for m in messages)
+    np.testing.assert_array_equal(shown.clip.key_times(), before)
+    assert not shown.undo_stack.can_undo
