@@ -123,7 +123,7 @@ def test_cli_hint_options(tmp_path, capsys, humanoid):
     assert got == {"LeftHand": list(hand), "Head": [0.0, 1.6, 0.0]}
     assert read_hints(None, None) is None
     out = tmp_path / "out"
-    common = ["--up", "y", "--forward", "z", "--method", "idw", "--no-clips", "-q", "-o"]
+    common = ["--up", "y", "--forward", "z", "--method", "idw", "--no-clips", "-o"]
     code = main(["autorig", str(mesh), "--hint", f"LeftHand={hand[0]},{hand[1] + 0.02},"
                  f"{hand[2]}"] + common + [str(out)])
     out_text, err = capsys.readouterr()

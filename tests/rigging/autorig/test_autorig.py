@@ -224,7 +224,7 @@ def test_cli_homer_prints_orientation_checks_and_times(tmp_path, capsys):
     if not HOMER.is_file():
         pytest.skip(f"{HOMER} is absent (shared test data)")
     out_dir = tmp_path / "homer"
-    code, out, err = _run(["autorig", str(HOMER), "-q", "-o", str(out_dir)], capsys)
+    code, out, err = _run(["autorig", str(HOMER), "-o", str(out_dir)], capsys)
     assert code == 0, err
     lines = out.splitlines()
     assert lines[0] == "orientation: up +y, forward +z (guessed)"

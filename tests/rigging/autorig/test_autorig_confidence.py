@@ -317,7 +317,7 @@ def test_cli_strict_refuses_a_not_sure_rig_and_warns_without(tmp_path, capsys, c
     err = capsys.readouterr().err
     assert status == 2 and not out.exists()
     assert "big_ears.obj" in err and "NOT SURE" in err and "nothing written" in err
-    status = main(["autorig", str(path), "--up", "y", "--forward", "z", "--no-clips", "-q",
+    status = main(["autorig", str(path), "--up", "y", "--forward", "z", "--no-clips",
                    "-o", str(out)])
     captured = capsys.readouterr()
     assert status == 0 and out.exists()
