@@ -13,7 +13,8 @@ alternating (the load of other processes drifts). Tasks per second over the whol
 start included), the tasks' own seconds summed and their mean, and the workers' CPU seconds
 (``getrusage`` of the ended worker processes: CPU per task, and CPU / wall = the cores the
 batch got, which tells a slow run from a machine that other work keeps busy); the ratio 2 workers / 1
-worker of each pair is measured in the same run. The load average before
+worker of each pair is measured in the same run, and right after it the reference: the cores
+that 1 and 2 busy-loop processes get (what the machine lets two workers have at that moment). The load average before
 and after is printed: other processes on the machine share its cores.
 
 **Auto-rig**: ``cow.obj`` (quadruped template) and ``homer.obj`` (humanoid template) from
@@ -44,6 +45,23 @@ TARGETS = ["humanoid", DATA / "threejs-characters" / "Xbot.glb",
 
 def load():
     return " ".join(f"{v:.2f}" for v in os.getloadavg())
+
+
+_SPIN = ("import time\nt0, c0 = time.time(), time.process_time()\n"
+         "while time.time() - t0 < {s}: pass\nprint(time.process_time() - c0)")
+
+
+def cores_available(seconds=3.0):
+    """Cores that 1 and then 2 busy-loop processes get right now (CPU seconds / wall):
+    the reference for the worker ratio, since other work shares this machine's cores."""
+    import subprocess
+
+    got = []
+    for n in (1, 2):
+        procs = [subprocess.Popen([sys.executable, "-c", _SPIN.format(s=seconds)],
+                                  stdout=subprocess.PIPE, text=True) for _ in range(n)]
+        got.append(sum(float(p.communicate()[0]) for p in procs) / seconds)
+    return got
 
 
 def copies_of_clips(folder, copies):
@@ -94,8 +112,10 @@ def bench_retarget(tmp, copies, thumbnails, rounds=1):
                   f"{busy:.1f} s (mean {busy / s.tasks:.3f} s), workers' CPU {cpu:.1f} s "
                   f"({cpu / s.tasks:.3f} s a task, {cpu / wall:.2f} cores used); load avg "
                   f"before {before}, after {load()}", flush=True)
-        print(f"  round {r + 1}: throughput 2 workers / 1 worker: {rates[2] / rates[1]:.2f}x",
-              flush=True)
+        one, two = cores_available()
+        print(f"  round {r + 1}: throughput 2 workers / 1 worker: {rates[2] / rates[1]:.2f}x; "
+              f"reference right after: 1 busy process got {one:.2f} cores, 2 got {two:.2f} "
+              f"together ({two / one:.2f}x)", flush=True)
 
 
 def bench_autorig(tmp):
