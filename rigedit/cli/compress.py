@@ -37,6 +37,9 @@ def compression_options(s, flag=None):
     s.add_argument("--shell", type=float, default=None, metavar="CM",
                    help=f"distance of the virtual vertices from each joint in cm (default "
                         f"{DEFAULT_SHELL_CM:g}, ACL's)")
+    s.add_argument("--skin-shell", action="store_true",
+                   help="take each joint's virtual-vertex distance from the rig's skin (its "
+                        "farthest weighted vertex) instead of --shell; the rig needs a mesh")
     s.add_argument("--meshopt", action="store_true",
                    help="also compress a glTF OUT's buffers with EXT_meshopt_compression "
                         "(required by the file; needs the meshopt package)")
@@ -84,6 +87,11 @@ def compress_and_write(rig, names, output, args):
     rig folder (``animations/NAME.rgc`` beside the mesh and skeleton). Returns the report's
     lines."""
     bound = dict(max_error=args.max_error_m, shell=args.shell_m)
+    if getattr(args, "skin_shell", False):
+        if len(rig.vertices) == 0:
+            raise UsageError(f"{rig.path}: --skin-shell needs a rig with a mesh; this one has "
+                             "only a skeleton (use --shell)")
+        bound["mesh"] = (rig.vertices, rig.binding.indices, rig.binding.weights)
     if Path(output).suffix.lower() in GLTF_SUFFIXES:
         from ..io.gltf_compress import save_gltf_compressed_rig
 

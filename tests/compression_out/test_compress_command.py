@@ -142,3 +142,25 @@ def test_120_hz_mocap(tmp_path):
     src, back = rigedit.load_rig(plain), rigedit.load_rig(small)
     assert _worst(src, back, src.clips) <= 0.05 / 100
     assert small.stat().st_size * 2 < plain.stat().st_size
+
+
+@pytest.mark.parametrize("suffix", [".rgc", ".glb"])
+def test_skin_shell_holds_the_bound_on_the_skins_own_distances(tmp_path, rig, suffix):
+    """--skin-shell: each joint's virtual vertices at its skin's distance, and the bound holds
+    measured that way; a rig without a mesh is one line, exit 2, nothing written."""
+    out = tmp_path / f"walk{suffix}"
+    assert main(["compress", "humanoid", "--clip", "walk", "--skin-shell", "--max-error",
+                 "0.05", "-o", str(out), "-q"]) == 0
+    back = rigedit.load_rig(out)
+    mesh = (rig.vertices, rig.binding.indices, rig.binding.weights)
+    err = measure_error(rig.skeleton, rig.clips["walk"], back.clips["walk"], mesh=mesh)
+    assert 0 < float(err.max()) <= 0.05 / 100
+
+
+def test_skin_shell_without_a_mesh_is_one_line(tmp_path, capsys):
+    if not CMU.is_file():
+        pytest.skip(f"{CMU} is absent (shared test data)")
+    out = tmp_path / "c.rgc"
+    assert main(["compress", str(CMU), "--skin-shell", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--skin-shell needs a rig with a mesh" in err and not out.exists()
