@@ -6,6 +6,7 @@ them from the shared file system.
 """
 from __future__ import annotations
 
+import fnmatch
 import glob
 import hashlib
 import os
@@ -46,28 +47,92 @@ def _is_rig_folder(path):
     return path.is_dir() and (path / "skeleton.json").is_file()
 
 
-def _search(folder, suffixes, take_rig_folders):
-    """Files under ``folder`` whose suffix is one of ``suffixes`` (hidden entries and
-    rig folders' insides skipped; rig folders themselves when ``take_rig_folders``)."""
+def _walk(folder, skip=None):
+    """``os.walk`` of ``folder`` that follows symlinked sub-folders (a library often links
+    its parts in) but enters each real folder once, so a symlink loop (``a -> .``) ends;
+    hidden entries and the folder ``skip`` (OUTDIR: a batch's own outputs are no inputs)
+    are left out. Yields ``(here, dirs, files)``; a caller may prune ``dirs`` in place."""
+    seen = set()
+    skip = None if skip is None else _identity(skip)
+    for root, dirs, files in os.walk(folder, followlinks=True):
+        me = _identity(root)
+        if me in seen or (skip is not None and me == skip):
+            dirs[:] = []
+            continue
+        seen.add(me)
+        dirs[:] = sorted(d for d in dirs if not d.startswith("."))
+        yield Path(root), dirs, [f for f in files if not f.startswith(".")]
+
+
+def _identity(path):
+    """``(device, inode)`` of a folder, the same through every symlink to it."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino
+
+
+def _search(folder, suffixes, take_rig_folders, skip=None):
+    """Files under ``folder`` whose suffix is one of ``suffixes`` (hidden entries, ``skip``
+    and rig folders' insides skipped; rig folders themselves when ``take_rig_folders``)."""
     found = []
-    for root, dirs, files in os.walk(folder):
-        here = Path(root)
+    for here, dirs, files in _walk(folder, skip):
         keep = []
-        for d in sorted(dirs):
-            if d.startswith("."):
-                continue
+        for d in dirs:
             if _is_rig_folder(here / d):
                 if take_rig_folders:
                     found.append(here / d)
                 continue
             keep.append(d)
         dirs[:] = keep
-        found += [here / f for f in files
-                  if not f.startswith(".") and Path(f).suffix.lower() in suffixes]
+        found += [here / f for f in files if Path(f).suffix.lower() in suffixes]
     return found
 
 
-def expand_inputs(job, inputs):
+def _match(parts, pattern):
+    """Whether the path components ``parts`` match the glob components ``pattern`` (``**``:
+    any number of components, none included)."""
+    if not pattern:
+        return not parts
+    if pattern[0] == "**":
+        return _match(parts, pattern[1:]) or bool(parts) and _match(parts[1:], pattern)
+    return bool(parts) and fnmatch.fnmatchcase(parts[0], pattern[0]) \
+        and _match(parts[1:], pattern[1:])
+
+
+def _glob(text, skip=None):
+    """The paths ``text`` matches. ``glob``'s own ``**`` follows symlinks without end (two
+    links to ``.`` make 2**40 paths), so a recursive pattern walks with :func:`_walk`."""
+    text = os.path.expanduser(text)
+    parts = Path(text).parts
+    if "**" not in parts:
+        yield from (Path(p) for p in glob.iglob(text))
+        return
+    first = next(i for i, part in enumerate(parts) if glob.has_magic(part))
+    root, pattern = Path(*parts[:first]) if first else Path("."), parts[first:]
+    for here, dirs, files in _walk(root, skip):
+        rel = here.relative_to(root).parts if here != root else ()
+        for name in dirs + files:
+            if _match(rel + (name,), pattern):
+                yield here / name
+
+
+def _resolve(path):
+    """``path`` made absolute with its symlinks resolved; a symlink loop (which ``resolve``
+    raises for) stays as it is, to fail its task with the system's own words."""
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError):
+        return Path(os.path.abspath(path))
+
+
+def _inside(path, folder):
+    """Whether ``path`` is ``folder`` or lies below it."""
+    return folder is not None and (path == folder or folder in path.parents)
+
+
+def expand_inputs(job, inputs, outdir=None):
     """Every path a batch of ``job`` reads from ``inputs``, sorted and without repeats.
 
     Parameters
@@ -76,9 +141,12 @@ def expand_inputs(job, inputs):
         A key of :data:`JOB_SUFFIXES`.
     inputs : list of str or os.PathLike
         Files (taken as they are, whatever their suffix: a wrong one is that task's error),
-        folders (searched for the job's suffixes; a rig folder is one input of the rig jobs),
-        globs (``**`` searches below a folder), and for the rig jobs bundled names
-        (``humanoid``, ``quadruped``).
+        folders (searched for the job's suffixes, symlinked sub-folders included; a rig
+        folder is one input of the rig jobs), globs (``**`` searches below a folder), and for
+        the rig jobs bundled names (``humanoid``, ``quadruped``).
+    outdir : Path, optional
+        The batch's OUTDIR: a folder search or a pattern leaves it out (a second run must
+        not take the first one's outputs for inputs); a file named on its own is kept.
 
     Returns
     -------
@@ -88,10 +156,12 @@ def expand_inputs(job, inputs):
     Raises
     ------
     BatchUsageError
-        An input that exists nowhere and matches nothing, or no input at all.
+        An input that exists nowhere and matches nothing, a folder that is OUTDIR, or no
+        input at all.
     """
     suffixes = JOB_SUFFIXES[job]
     rigs = job in _RIG_JOBS
+    own = None if outdir is None else _resolve(Path(outdir))
     out = set()
     for text in inputs:
         text = str(text)
@@ -99,21 +169,26 @@ def expand_inputs(job, inputs):
         if rigs and text in BUNDLED and not path.exists():
             out.add(Path(text))
         elif _is_rig_folder(path) and rigs:
-            out.add(path.resolve())
+            out.add(_resolve(path))
         elif path.is_dir():
-            found = _search(path, suffixes, rigs)
+            if own is not None and _resolve(path) == own:
+                raise BatchUsageError(f"{text}: expected inputs apart from OUTDIR, got OUTDIR "
+                                      "itself (its outputs would be the next run's inputs)")
+            found = _search(path, suffixes, rigs, skip=own)
             if not found:
                 raise BatchUsageError(f"{text}: no {job} input in this folder (looked for "
                                       f"{', '.join(suffixes)})")
-            out.update(p.resolve() for p in found)
+            out.update(_resolve(p) for p in found)
         elif path.exists():
-            out.add(path.resolve())
+            out.add(_resolve(path))
         elif glob.has_magic(text):
-            found = [Path(p) for p in glob.iglob(os.path.expanduser(text), recursive=True)]
-            found = [p for p in found if p.is_file() or (rigs and _is_rig_folder(p))]
+            found = [_resolve(p) for p in _glob(text, skip=own)
+                     if p.is_file() or (rigs and _is_rig_folder(p))]
+            found = [p for p in found if not _inside(p, own)]
             if not found:
-                raise BatchUsageError(f"{text}: the pattern matches no file")
-            out.update(p.resolve() for p in found)
+                raise BatchUsageError(f"{text}: the pattern matches no file"
+                                      + (" outside OUTDIR" if own is not None else ""))
+            out.update(found)
         else:
             raise BatchUsageError(f"{text}: no such file or folder")
         if len(out) > MAX_INPUTS:

@@ -67,9 +67,11 @@ class BatchProgress:
             self.bar.update(1)
             return
         what = entry["status"] + (f" ({entry['error']})" if entry.get("error") else "")
+        # a lost task (its worker died) has no time of its own: None
+        took = entry.get("seconds")
+        took = f"{took:.1f} s" if isinstance(took, (int, float)) else "no time"
         print(f"[{self.done + self.failed}/{self.total}] {entry['task']}: {what}, "
-              f"{entry.get('seconds', 0):.1f} s; {counts}, ETA {_clock(self.eta())}",
-              file=self.stream, flush=True)
+              f"{took}; {counts}, ETA {_clock(self.eta())}", file=self.stream, flush=True)
 
     def close(self):
         if self.bar is not None:

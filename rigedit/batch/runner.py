@@ -150,13 +150,13 @@ def run(job, inputs, out, workers=None, scheduler=None, resume=False, quiet=True
     """
     t0 = time.perf_counter()
     settings = check_options(job, job_options)
-    sources = expand_inputs(job, inputs)
+    outdir = outdir_path(out)
+    sources = expand_inputs(job, inputs, outdir)
     say = (lambda line: None) if quiet else (lambda line: print(f"rigedit: batch: {line}",
                                                                  file=sys.stderr))
     warm = ("rigedit.batch.jobs",) + (("rigedit.render.recorder",) if settings["thumbnails"]
                                       or job == "render" else ())
     engine = Engine(workers, scheduler, timeout=timeout, say=say, warm=warm)  # checks options
-    outdir = outdir_path(out)
     tasks = plan(job, sources, outdir, settings)
     manifest = Manifest(outdir)
     version = rigedit_version()

@@ -13,7 +13,7 @@ import math
 from pathlib import Path
 
 from .inputs import BatchUsageError, rig_source
-from .manifest import task_id
+from .manifest import MANIFEST_DIR, task_id
 
 __all__ = ["JOBS", "check_options", "plan", "THUMBS_DIR"]
 
@@ -114,7 +114,8 @@ def _outputs(job, base, settings):
     if job in ("autorig", "retarget"):
         return [base + _FORMATS[settings["format"]]]
     if job == "render":
-        name = f"{base}_{settings['clip']}"
+        # a clip's name may hold a slash ("Take 001/run"): no sub-folder of OUTDIR
+        name = f"{base}_{_short(settings['clip'].replace('/', '_').replace(chr(0), '_'))}"
         return [f"{name}.{settings['video']}", f"{name}_sheet.png"]
     if job == "convert":
         return [base + _FORMATS[settings["to"]]]
@@ -129,15 +130,39 @@ def _pairs(job, sources, settings):
     return [(s, None) for s in sources]
 
 
-def _unique_bases(pairs):
-    """An output base name per pair: the input's stem (and the target's); a name two inputs
-    share gets a short hash of the input's path, so no task overwrites another's output."""
+#: Names in OUTDIR that are the batch's own: an output called so would overwrite them (a
+#: rig folder ``manifest/`` mixed with the entries) or be mistaken for them.
+RESERVED = {MANIFEST_DIR, THUMBS_DIR, "manifest.json", "report.html"}
+#: Longest output base in UTF-8 bytes: a file name has 255, and the writers' temporary
+#: names (``.NAME.pid123-abcdefgh.tmp``) add about 30.
+MAX_BASE_BYTES = 160
+
+
+def _short(base):
+    """``base`` cut to :data:`MAX_BASE_BYTES` bytes at a character's boundary."""
+    return base.encode()[:MAX_BASE_BYTES].decode(errors="ignore")
+
+
+def _unique_bases(job, pairs, settings):
+    """An output base name per pair: the input's stem (and the target's). A name that two
+    pairs share (``a/walk.bvh`` and ``b/walk.bvh``; two targets ``x/hero.glb`` and
+    ``y/hero.glb``), whose output would be one of the batch's own files (:data:`RESERVED`)
+    or that is too long for a file name gets a short hash of the input's path (and the
+    target's), so no task overwrites another's output or the manifest."""
     bases = [Path(str(s)).stem + (f"__{Path(str(t)).stem}" if t else "") for s, t in pairs]
     seen = {}
     for b in bases:
         seen[b] = seen.get(b, 0) + 1
-    return [b if seen[b] == 1 else f"{b}-{hashlib.sha1(str(s).encode()).hexdigest()[:6]}"
-            for b, (s, _) in zip(bases, pairs)]
+
+    def clash(base):
+        return (seen[base] > 1 or len(base.encode()) > MAX_BASE_BYTES
+                or any(Path(o).parts[0] in RESERVED for o in _outputs(job, base, settings)))
+
+    def tag(source, target):
+        key = str(source) + (f"\0{target}" if target else "")
+        return hashlib.sha1(key.encode()).hexdigest()[:6]
+
+    return [f"{_short(b)}-{tag(s, t)}" if clash(b) else b for b, (s, t) in zip(bases, pairs)]
 
 
 def plan(job, sources, outdir, settings):
@@ -154,7 +179,7 @@ def plan(job, sources, outdir, settings):
     """
     pairs = _pairs(job, sources, settings)
     tasks = []
-    for (source, target), base in zip(pairs, _unique_bases(pairs)):
+    for (source, target), base in zip(pairs, _unique_bases(job, pairs, settings)):
         tid = task_id(job, source, target)
         reads = [str(source)] + ([target] if target else [])
         reads += [settings[k] for k in ("template", "map") if settings.get(k)]

@@ -1,0 +1,83 @@
+"""Adversarial inputs of a batch: symlinks (to a file, to a folder, loops), an OUTDIR inside
+the searched folder, the same file named twice, names with unusual characters."""
+import os
+import time
+
+import pytest
+
+from rigedit.batch.inputs import BatchUsageError, expand_inputs
+
+
+def _touch(path, text="x"):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+    return path
+
+
+def test_a_recursive_glob_ends_on_symlink_loops(tmp_path):
+    # two links to "." made glob's own ** list 2**40 paths (it never came back)
+    sub = tmp_path / "lib" / "sub"
+    x = _touch(sub / "x.bvh")
+    os.symlink(".", sub / "a")
+    os.symlink(".", sub / "b")
+    t0 = time.perf_counter()
+    assert expand_inputs("retarget", [f"{tmp_path}/lib/**/*.bvh"]) == [x]
+    assert expand_inputs("retarget", [tmp_path / "lib"]) == [x]
+    assert time.perf_counter() - t0 < 5
+
+
+def test_a_symlink_loop_file_is_a_task_not_a_crash(tmp_path):
+    # Path.resolve raised RuntimeError("Symlink loop") out of the command
+    a = _touch(tmp_path / "lib" / "a.bvh")
+    os.symlink("loop.bvh", tmp_path / "lib" / "loop.bvh")
+    got = expand_inputs("retarget", [tmp_path / "lib"])
+    assert got == [a, tmp_path / "lib" / "loop.bvh"]
+    with pytest.raises(BatchUsageError, match="no such file"):   # named alone: nothing there
+        expand_inputs("retarget", [tmp_path / "lib" / "loop.bvh"])
+
+
+def test_a_symlinked_sub_folder_is_searched_and_a_link_to_a_file_is_its_target(tmp_path):
+    real = _touch(tmp_path / "elsewhere" / "run.bvh")
+    (tmp_path / "lib").mkdir()
+    os.symlink(tmp_path / "elsewhere", tmp_path / "lib" / "linked")
+    os.symlink(real, tmp_path / "lib" / "alias.bvh")
+    # the folder, the link to the file, the file itself and a glob: one input
+    got = expand_inputs("retarget", [tmp_path / "lib", tmp_path / "lib" / "alias.bvh", real,
+                                     f"{tmp_path}/elsewhere/*.bvh"])
+    assert got == [real]
+
+
+def test_outdir_inside_the_searched_folder_is_left_out(tmp_path):
+    lib = tmp_path / "lib"
+    walk = _touch(lib / "walk.bvh")
+    out = lib / "out"
+    _touch(out / "walk__humanoid.glb")   # a first run's output
+    _touch(out / "sub" / "more.bvh")
+    assert expand_inputs("retarget", [lib], outdir=out) == [walk]
+    assert expand_inputs("retarget", [f"{lib}/**/*.bvh"], outdir=out) == [walk]
+    with pytest.raises(BatchUsageError, match="matches no file outside OUTDIR"):
+        expand_inputs("retarget", [f"{lib}/**/*.glb"], outdir=out)
+    with pytest.raises(BatchUsageError, match="matches no file outside OUTDIR"):
+        expand_inputs("retarget", [f"{out}/*.glb"], outdir=out)
+    with pytest.raises(BatchUsageError, match="OUTDIR itself"):
+        expand_inputs("retarget", [lib], outdir=lib)
+    # a file named on its own is taken even there
+    assert expand_inputs("retarget", [out / "walk__humanoid.glb"], outdir=out) == \
+        [out / "walk__humanoid.glb"]
+
+
+@pytest.mark.parametrize("name", ["my walk.bvh", "marche_é_歩く.bvh", "-walk.bvh", "#1 walk.bvh",
+                                  "100% walk.bvh", "it's \"walk\".bvh", "<script>alert(1)<\\script>.bvh",
+                                  "walk[1].bvh"])
+def test_unusual_names_are_found_once_by_folder_glob_and_path(tmp_path, name):
+    f = _touch(tmp_path / "lib" / name)
+    got = expand_inputs("retarget", [tmp_path / "lib", f, f"{tmp_path}/lib/*.bvh"])
+    assert got == [f]
+
+
+def test_a_folder_named_like_a_file_and_empty_files(tmp_path):
+    (tmp_path / "lib" / "x.bvh").mkdir(parents=True)
+    empty = _touch(tmp_path / "lib" / "empty.bvh", "")
+    assert expand_inputs("retarget", [tmp_path / "lib", f"{tmp_path}/lib/*.bvh"]) == [empty]
+    with pytest.raises(BatchUsageError, match="no retarget input in this folder"):
+        expand_inputs("retarget", [tmp_path / "lib" / "x.bvh"])

@@ -1,0 +1,52 @@
+"""Adversarial plans: outputs that would collide with each other or with the batch's own
+files (the manifest folder, the thumbnails, the report), names too long for a file."""
+from pathlib import Path
+
+from rigedit.batch.tasks import RESERVED, check_options, plan
+
+
+def _outputs(tasks):
+    return [o for t in tasks for o in t["outputs"]]
+
+
+def test_two_targets_with_one_name_do_not_share_an_output(tmp_path):
+    # x/hero.glb and y/hero.glb: both tasks of walk.bvh wrote walk__hero.glb
+    a, b = tmp_path / "x" / "hero.glb", tmp_path / "y" / "hero.glb"
+    for p in (a, b):
+        p.parent.mkdir()
+        p.write_text("x")
+    settings = check_options("retarget", {"to": [str(a), str(b)]})
+    tasks = plan("retarget", [tmp_path / "walk.bvh", tmp_path / "run.bvh"], tmp_path, settings)
+    outs = _outputs(tasks)
+    assert len(tasks) == 4 and len(set(outs)) == 4
+    assert all(o.startswith(("walk__hero-", "run__hero-")) for o in outs)
+
+
+def test_an_input_named_like_the_manifest_or_the_thumbnails_gets_its_own_name(tmp_path):
+    inputs = [tmp_path / n for n in ("manifest.glb", "thumbs.glb", "report.html.glb",
+                                     "manifest.json.bvh", "walk.glb")]
+    for job, options in (("convert", {"to": "folder"}), ("convert", {"to": "glb"}),
+                         ("autorig", {"format": "folder"})):
+        tasks = plan(job, inputs, tmp_path, check_options(job, options))
+        tops = [Path(o).parts[0] for o in _outputs(tasks)]
+        assert not set(tops) & RESERVED, (job, tops)
+        assert len(set(tops)) == len(tops)
+        assert tasks[-1]["outputs"][0] in ("walk", "walk.glb")   # an ordinary name stays
+
+
+def test_a_long_name_is_cut_to_fit_a_file_name(tmp_path):
+    motion = tmp_path / ("歩く" * 40 + ".bvh")   # 240 bytes
+    target = tmp_path / ("走る" * 40 + ".glb")
+    target.write_text("x")
+    tasks = plan("retarget", [motion], tmp_path,
+                 check_options("retarget", {"to": [str(target)]}))
+    name = tasks[0]["outputs"][0]
+    assert len(name.encode()) <= 200 and name.endswith(".glb") and name.startswith("歩く")
+    # the writers' temporary name beside it fits too (255 bytes)
+    assert len(f".{name}.pid4194304-abcdefgh.tmp".encode()) <= 255
+
+
+def test_a_render_clip_with_a_slash_stays_in_outdir(tmp_path):
+    tasks = plan("render", [tmp_path / "hero.glb"], tmp_path,
+                 check_options("render", {"clip": "Take 001/../../run"}))
+    assert all("/" not in o for o in tasks[0]["outputs"])

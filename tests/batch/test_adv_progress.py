@@ -1,0 +1,21 @@
+"""The plain progress lines (a log, CI) for every kind of entry, a lost task's included."""
+import io
+
+from rigedit.batch.progress import BatchProgress
+from rigedit.batch.runner import _lost_entry
+from rigedit.batch.tasks import check_options, plan
+
+
+def test_a_lost_task_is_one_progress_line_not_a_crash(tmp_path):
+    # its entry's seconds is None: "{None:.1f}" raised TypeError and stopped the batch
+    tasks = plan("noop", [tmp_path / "a.bvh", tmp_path / "b.bvh"], tmp_path,
+                 check_options("noop", {}))
+    stream = io.StringIO()
+    bar = BatchProgress(2, stream=stream)
+    bar.update(_lost_entry(tasks[0], RuntimeError("KilledWorker: gone")))
+    bar.update({"task": tasks[1]["id"], "status": "ok", "seconds": 0.25})
+    lines = stream.getvalue().splitlines()
+    assert len(lines) == 2
+    assert lines[0].startswith(f"[1/2] {tasks[0]['id']}: failed (its worker died")
+    assert "no time; done 0, failed 1, remaining 1" in lines[0]
+    assert "0.2 s; done 1, failed 1, remaining 0" in lines[1]
