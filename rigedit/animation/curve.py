@@ -304,7 +304,10 @@ class Curve:
 
         A time factor below :data:`MIN_TIME_FACTOR` (zero or negative: keys would merge or
         mirror in time, out of order) is raised to it; the scaled keys' times are then
-        clamped between the unscaled neighbours as :meth:`with_keys_moved` does.
+        clamped between the unscaled neighbours as :meth:`with_keys_moved` does, and kept
+        apart: keys squeezed against a neighbour (a large factor) or together (a small one)
+        stay :data:`MIN_GAP` apart, or as far apart as they were or as the room between the
+        neighbours allows when that is less (they never merge or swap).
         """
         if not np.isfinite(time_factor) or not np.isfinite(value_factor):
             raise ValueError(f"curve: expected finite factors, got {time_factor}, "
@@ -313,11 +316,7 @@ class Curve:
         idx = np.unique(np.asarray(indices, dtype=int).reshape(-1))
         times, values = self.times.copy(), self.values.copy()
         left, right = self.left.copy(), self.right.copy()
-        new_t = time_pivot + (times[idx] - time_pivot) * time_factor
-        lo, hi = _bounds(self.times, idx)
-        new_t = np.clip(new_t, np.maximum(lo + MIN_GAP, np.minimum(times[idx], 0.0)),
-                        hi - MIN_GAP)
-        new_t = np.maximum.accumulate(np.maximum(new_t, np.r_[-np.inf, new_t[:-1] + MIN_GAP]))
+        new_t = _spaced(self.times, idx, time_pivot + (times[idx] - time_pivot) * time_factor)
         for pts in (left, right):
             pts[idx, 0] = new_t + (pts[idx, 0] - times[idx]) * time_factor
             pts[idx, 1] = value_pivot + (pts[idx, 1] - value_pivot) * value_factor
@@ -366,11 +365,46 @@ def _bounds(times, idx):
     return lo, hi
 
 
-def _clamp_shift(times, idx, dt):
-    """``dt`` clamped so the keys ``idx`` shifted by it stay between their unmoved
-    neighbours (:data:`MIN_GAP` apart) and not before time 0 (a clip's start; a key already
-    before it does not move further back)."""
+def _gaps(times, idx):
+    """(M,) least distance each moved key keeps from its unmoved neighbours: :data:`MIN_GAP`,
+    or less where the key is already closer (a file may hold keys 1e-9 s apart; a move
+    never pushes them apart nor brings them closer)."""
     lo, hi = _bounds(times, idx)
     t = times[idx]
-    floor = np.maximum(lo + MIN_GAP, np.minimum(t, 0.0))   # clips start at 0
-    return float(np.clip(dt, np.max(floor - t), np.min(hi - MIN_GAP - t)))
+    return lo, hi, np.minimum(MIN_GAP, t - lo), np.minimum(MIN_GAP, hi - t)
+
+
+def _clamp_shift(times, idx, dt):
+    """``dt`` clamped so the keys ``idx`` shifted by it stay between their unmoved
+    neighbours (:func:`_gaps` apart) and not before time 0 (a clip's start; a key already
+    before it does not move further back). The range always holds 0."""
+    lo, hi, gap_lo, gap_hi = _gaps(times, idx)
+    t = times[idx]
+    floor = np.maximum(lo + gap_lo, np.minimum(t, 0.0))   # clips start at 0
+    low, high = np.max(floor - t), np.min(hi - gap_hi - t)
+    return float(np.clip(dt, min(low, 0.0), max(high, 0.0)))
+
+
+def _spaced(times, idx, wanted):
+    """(M,) the times ``wanted`` for the sorted keys ``idx``, clamped between their unmoved
+    neighbours and not before time 0 (as :func:`_clamp_shift`), and strictly increasing: each
+    run of moved keys between the same two unmoved ones keeps its keys a gap apart, the
+    least of :data:`MIN_GAP`, the run's closest keys now, and an even share of the room."""
+    lo, hi, gap_lo, gap_hi = _gaps(times, idx)
+    out = np.asarray(wanted, dtype=np.float64).copy()
+    t = times[idx]
+    runs = np.flatnonzero(np.r_[True, (lo[1:] != lo[:-1]) | (hi[1:] != hi[:-1])])
+    for start, stop in zip(runs, np.r_[runs[1:], len(idx)]):
+        a, b = float(lo[start]), float(hi[start])
+        floor = max(a + gap_lo[start], min(float(t[start]), 0.0))
+        ceil = b - gap_hi[stop - 1]
+        m = stop - start
+        gap = min(MIN_GAP, float(np.min(np.diff(t[start:stop]), initial=np.inf)),
+                  (ceil - floor) / max(m - 1, 1) if np.isfinite(ceil) else np.inf)
+        run = np.clip(out[start:stop], floor, ceil)
+        steps = gap * np.arange(m)
+        # forward: at least a gap after the key before; backward: a gap before the next
+        run = np.minimum(np.maximum.accumulate(run - steps) + steps, ceil)
+        run = np.minimum.accumulate((run - steps)[::-1])[::-1] + steps
+        out[start:stop] = run
+    return out

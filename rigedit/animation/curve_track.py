@@ -8,18 +8,22 @@ Conversion (:func:`curves_from_track`), per mode of the track:
 ``linear``                                 ``linear`` keys (exact)
 ``nlerp``, ``slerp``, ``hybrid``           ``bezier`` keys whose handles follow the
 (rotations)                                track's Euler velocity on each side of the key
-                                           (a finite difference): Euler angles running
-                                           linearly between keys would leave the arc slerp
-                                           takes (9 degrees off mid-segment on keys 25 to
-                                           123 degrees apart; these handles: under 1 for
-                                           slerp, under 2 for nlerp)
+                                           (a finite difference), or per segment the Euler
+                                           secant or a least-squares fit of its Euler
+                                           angles where either is nearer the track (near
+                                           gimbal lock; :func:`_best_segments`): Euler
+                                           angles running linearly between keys would
+                                           leave the arc slerp takes (9 degrees off
+                                           mid-segment on keys 25 to 123 degrees apart;
+                                           these handles: under 0.2 for slerp, under 0.5
+                                           for nlerp)
 ``catmull_rom``, ``cubic_spline``          ``bezier`` keys with handles a third of
                                            each segment long: exact for vectors (a cubic
                                            Hermite is that Bezier); for a rotation the
                                            handles follow the Euler velocity as above (a
                                            cubic in Euler angles is not one in quaternions:
-                                           same keys and velocities, up to 8 degrees apart
-                                           mid-segment on the same keys)
+                                           up to 2.3 degrees apart mid-segment on the same
+                                           keys)
 =========================================  ===============================================
 
 Converted handles are ``aligned`` where the key's velocity is the same on both sides (a
@@ -33,7 +37,7 @@ from __future__ import annotations
 import numpy as np
 
 from .curve import Curve
-from .euler_curves import DEFAULT_ORDER, nearest, principal, quat_to_euler
+from .euler_curves import DEFAULT_ORDER, euler_to_quat, nearest, principal, quat_to_euler
 
 __all__ = ["curves_from_track", "remove_times", "retime"]
 
@@ -57,6 +61,58 @@ def _slopes(track, euler, euler_order):
         out[:, side] = sign * (angles - euler) / eps
     # the end keys' outer sides are clamped (no motion beyond the keys): reuse the inner one
     out[0, 0], out[-1, 1] = out[0, 1], out[-1, 0]
+    return _best_segments(track, euler, euler_order, out)
+
+
+#: Inner points (fractions of a segment) where converted rotation segments are compared.
+_PROBES = np.arange(1, 8) / 8.0
+
+
+def _hermite_basis(s):
+    """(S, 4) cubic Hermite weights of value 0, slope 0 (times the span), value 1, slope 1."""
+    s2, s3 = s * s, s * s * s
+    return np.stack([2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, -2 * s3 + 3 * s2, s3 - s2], axis=1)
+
+
+def _best_segments(track, euler, order, slopes):
+    """(K, 2, 3) ``slopes`` with each segment's pair (key k's out-, key k + 1's in-velocity)
+    replaced by the best of three candidates, by the largest angle between the Euler cubic
+    and the track at :data:`_PROBES`: the finite difference, the Euler secant (angles
+    running linearly), and a least-squares fit of the segment's Euler angles.
+
+    The finite difference is the track's true Euler velocity at the keys, but near gimbal
+    lock (the middle angle near +-90 degrees) that velocity grows without bound (the first
+    and last angles swing against each other) and a cubic through it overshoots by
+    thousands of degrees: 84 degrees off the track between keys where a key is at Y = 90.
+    """
+    times = track.times
+    dt = np.diff(times)
+    probe_t = (times[:-1, None] + dt[:, None] * _PROBES[None, :]).reshape(-1)
+    truth = track.sample_many(probe_t).reshape(len(dt), len(_PROBES), 4)
+    basis = _hermite_basis(_PROBES)                            # (S, 4)
+    v0, v1 = euler[:-1], euler[1:]                             # (K-1, 3)
+    ends = basis[None, :, 0, None] * v0[:, None] + basis[None, :, 2, None] * v1[:, None]
+    # the segment's Euler angles: the triple of each probe nearest the straight line
+    line = v0[:, None] + (v1 - v0)[:, None] * _PROBES[None, :, None]
+    target = nearest(principal(truth.reshape(-1, 4), order), order,
+                     line.reshape(-1, 3)).reshape(line.shape)
+    fit = np.linalg.pinv(basis[:, [1, 3]]) @ (target - ends).transpose(1, 0, 2).reshape(
+        len(_PROBES), -1)                                      # (2, (K-1) * 3)
+    fit = fit.reshape(2, len(dt), 3).transpose(1, 0, 2) / dt[:, None, None]
+    secant = ((v1 - v0) / dt[:, None])[:, None].repeat(2, axis=1)
+    finite = np.stack([slopes[:-1, 1], slopes[1:, 0]], axis=1)   # (K-1, 2, 3)
+    errors, candidates = [], (finite, secant, fit)
+    for m in candidates:
+        angles = ends + dt[:, None, None] * (basis[None, :, 1, None] * m[:, None, 0]
+                                             + basis[None, :, 3, None] * m[:, None, 1])
+        q = euler_to_quat(angles.reshape(-1, 3), order).reshape(truth.shape)
+        dot = np.clip(np.abs(np.sum(q * truth, axis=-1)), 0.0, 1.0)
+        errors.append(np.max(2 * np.arccos(dot), axis=1))
+    # ties keep the finite difference (the track's own velocity: smooth keys stay aligned)
+    best = np.argmin(np.stack(errors) - np.array([1e-9, 0, 0])[:, None], axis=0)
+    chosen = np.stack(candidates)[best, np.arange(len(dt))]
+    out = slopes.copy()
+    out[:-1, 1], out[1:, 0] = chosen[:, 0], chosen[:, 1]
     return out
 
 

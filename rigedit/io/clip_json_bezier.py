@@ -30,9 +30,13 @@ MAX_CURVE_KEYS = 10_000_000
 
 def bezier_entry(track):
     """The JSON fields of a bezier track (to merge into its entry)."""
-    curves = [{"times": c.times.round(9).tolist(), "values": c.values.round(9).tolist(),
-               "interpolation": list(c.interpolation), "left": c.left.round(9).tolist(),
-               "right": c.right.round(9).tolist(), "left_type": list(c.left_type),
+    # full precision (Python's shortest round-tripping repr), not rounded as plain tracks
+    # are: keys closer than the rounding would merge and the file would not load again, and
+    # handles moved off the exact thirds of their segment would turn a CUBICSPLINE glTF
+    # export of the loaded clip into a resampled one
+    curves = [{"times": c.times.tolist(), "values": c.values.tolist(),
+               "interpolation": list(c.interpolation), "left": c.left.tolist(),
+               "right": c.right.tolist(), "left_type": list(c.left_type),
                "right_type": list(c.right_type)} for c in track.curves]
     out = {"interpolation": "bezier", "curves": curves}
     if track.channel == "rotation":
