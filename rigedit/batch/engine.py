@@ -15,6 +15,7 @@ running scheduler keeps its own setting (said in one line when it is not 1).
 from __future__ import annotations
 
 import logging
+import math
 import os
 import uuid
 from pathlib import Path
@@ -68,7 +69,14 @@ class Engine:
         if workers is not None and not (isinstance(workers, int) and 1 <= workers <= 1024):
             raise BatchUsageError(f"--workers: expected a number of processes from 1 to 1024, "
                                   f"got {workers!r}")
-        self.workers, self.scheduler, self.timeout = workers, scheduler, float(timeout)
+        try:
+            seconds = float(timeout)
+        except (TypeError, ValueError):
+            seconds = math.nan
+        if not (math.isfinite(seconds) and 0 < seconds <= 86400):
+            raise BatchUsageError(f"--timeout: expected seconds from more than 0 to 86400, "
+                                  f"got {timeout!r}")
+        self.workers, self.scheduler, self.timeout = workers, scheduler, seconds
         self.say = say or (lambda line: None)
         self.cluster = self.client = None
         self.futures = []
@@ -96,7 +104,7 @@ class Engine:
     def _connect(self, distributed):
         try:
             self.client = distributed.Client(self.scheduler, timeout=self.timeout)
-        except (OSError, TimeoutError, ValueError) as exc:
+        except Exception as exc:   # also a transport this Dask lacks (ucx://: TypeError)
             raise BatchUsageError(f"{self.scheduler}: the scheduler does not answer within "
                                   f"{self.timeout:g} s ({' '.join(str(exc).split())[:160]})"
                                   ) from None

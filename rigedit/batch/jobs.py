@@ -219,6 +219,10 @@ def run_task(task):
         try:
             entry["inputs"] = _reads(task)
             entry["quality"], entry["unsure"] = _JOBS[task["job"]](task)
+            # what this task wrote, so that a resume can tell it from a file another batch
+            # wrote later under the same name into the same OUTDIR
+            entry["output_stamps"] = {o: quick_stamp(Path(task["outdir"]) / o)
+                                      for o in task["outputs"]}
             entry["status"] = "ok"
         except Exception as exc:  # the task's failure: one row, the batch goes on
             entry["error"], entry["failure"] = one_line(exc), "error"

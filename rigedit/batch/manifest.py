@@ -9,7 +9,8 @@ and tools; the per-task files are what ``--resume`` reads.
 An entry's fields: ``task`` (its id), ``job``, ``input``, ``target`` (a retarget's target
 rig, None otherwise), ``inputs`` (every file read: ``{path: {"hash": "sha256:...",
 "stamp": [size, mtime_ns]}}``), ``settings`` (the job's options), ``rigedit`` (version),
-``outputs`` (paths relative to OUTDIR), ``thumbnail``, ``status`` (``ok`` or ``failed``),
+``outputs`` (paths relative to OUTDIR), ``output_stamps`` (``{output: [size, mtime_ns]}`` as
+the task wrote them), ``thumbnail``, ``status`` (``ok`` or ``failed``),
 ``error`` (one line), ``failure`` (``error``: the task raised; ``lost``: its worker died
 twice), ``seconds``, ``finished`` (UTC, ISO 8601), ``worker``, ``quality`` (the job's
 figures), ``unsure`` (reasons a person should look), ``warnings``.
@@ -95,7 +96,8 @@ class Manifest:
     def done(self, task, version):
         """True when ``task``'s entry says it succeeded with the same inputs (by content:
         a file whose size and modification time changed is hashed again), settings, target
-        and rigedit version, and its outputs are all there: ``--resume`` skips it."""
+        and rigedit version, and its outputs are all there as it wrote them (their size and
+        modification time): ``--resume`` skips it."""
         entry = self.read(task["id"])
         if entry is None or entry.get("status") != "ok" or entry.get("rigedit") != version:
             return False
@@ -103,8 +105,10 @@ class Manifest:
             return False
         if entry.get("outputs") != task["outputs"]:
             return False
-        if not all((self.outdir / o).exists() for o in entry["outputs"]):
-            return False
+        stamps = entry.get("output_stamps") or {}
+        if not all(stamps.get(o) is not None and quick_stamp(self.outdir / o) == stamps[o]
+                   for o in entry["outputs"]):
+            return False   # missing, or not as this task wrote it (another batch's since)
         recorded = entry.get("inputs") or {}
         return set(recorded) == set(task["reads"]) and all(
             _same_content(src, recorded[src]) for src in task["reads"])
@@ -131,6 +135,29 @@ def _read_entry(path):
         entry = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError):
         return None
-    if not isinstance(entry, dict) or entry.get("task") != path.stem:
+    if not isinstance(entry, dict) or entry.get("task") != path.stem or not _well_formed(entry):
         return None
     return entry
+
+
+_STR, _OPT_STR, _DICT = (str,), (str, type(None)), (dict, type(None))
+#: The type of each field an entry may have; the report and ``--resume`` rely on them.
+_FIELDS = {"job": _STR, "input": _STR, "status": _STR, "target": _OPT_STR,
+           "thumbnail": _OPT_STR, "error": _OPT_STR, "failure": _OPT_STR,
+           "finished": _OPT_STR, "worker": _OPT_STR, "rigedit": _OPT_STR,
+           "inputs": _DICT, "settings": _DICT, "quality": _DICT, "output_stamps": _DICT,
+           "seconds": (int, float, type(None))}
+_LISTS = ("outputs", "unsure", "warnings")
+
+
+def _well_formed(entry):
+    """Whether every field of ``entry`` has its type (JSON that parses but was edited by
+    hand or cut to another shape is no entry: its task runs again, the report shows no
+    half row)."""
+    if any(k not in entry for k in ("input", "status", "outputs")) \
+            or entry["status"] not in ("ok", "failed"):
+        return False
+    if any(k in entry and not isinstance(entry[k], t) for k, t in _FIELDS.items()):
+        return False
+    return all(isinstance(entry.get(k, []), list)
+               and all(isinstance(v, str) for v in entry.get(k, [])) for k in _LISTS)

@@ -4,8 +4,9 @@ Self-contained: the CSS and the script are inline, nothing is fetched from the n
 thumbnails are files in OUTDIR referenced relatively (the page works from a copy of OUTDIR).
 The rows are written as HTML (the page reads without its script); the script puts the rows
 that need a look (failed, or a result the job is not sure of) first, sorts by any column
-(click its heading) and filters by status and by "needs a look". The filter and the sort live in the
-address's fragment (``report.html#status=failed&look=1&sort=time&desc=1``) so a link keeps
+(click its heading) and filters by status and by "needs a look". The filter and the sort
+live in the address's fragment (``report.html#status=failed&look=1&sort=time&desc=1``; a
+part that is not valid percent-encoding is left out, not fatal) so a link keeps
 them and a test can load the page in that state.
 """
 from __future__ import annotations
@@ -14,6 +15,7 @@ import datetime
 import html
 import math
 from pathlib import Path
+from urllib.parse import quote
 
 from ..io.atomic import atomic_write
 from .manifest import rigedit_version
@@ -42,8 +44,9 @@ _SCRIPT = """
 const table=document.getElementById('tasks'),body=table.tBodies[0];
 const heads=[...table.tHead.rows[0].cells],st=document.getElementById('status'),
 lk=document.getElementById('look'),shown=document.getElementById('shown');
+function dec(x){try{return decodeURIComponent(x)}catch(e){return null}}
 function state(){const s={};location.hash.slice(1).split('&').forEach(p=>{
- const [k,v]=p.split('=');if(k)s[decodeURIComponent(k)]=decodeURIComponent(v||'')});return s}
+ const [k,v]=p.split('='),dk=dec(k||''),dv=dec(v||'');if(dk&&dv!==null)s[dk]=dv});return s}
 function key(row,i){const c=row.cells[i],v=c.dataset.v!==undefined?c.dataset.v:c.textContent;
  const n=parseFloat(v);return v!==''&&!isNaN(n)&&isFinite(v)?n:v.toLowerCase()}
 function apply(){const s=state(),status=s.status||'all',look=s.look==='1';
@@ -92,11 +95,17 @@ def _cell(value, sort=None):
     return f'<td{data}{" class=num" if num else ""}>{html.escape(_text(value))}</td>'
 
 
+def _href(rel):
+    """A path relative to OUTDIR as a relative URL: percent-encoded, so that a name holding
+    ``#``, ``%``, ``?`` or ``:`` (``a:b.glb`` read as a scheme) still reaches its file."""
+    return html.escape(quote(Path(rel).as_posix()))
+
+
 def _media(entry):
     thumb = entry.get("thumbnail")
     if not thumb:
         return '<td data-v="0">-</td>'
-    src = html.escape(Path(thumb).as_posix())
+    src = _href(thumb)
     return (f'<td data-v="1"><a href="{src}"><img class="thumb" src="{src}" loading="lazy" '
             f'alt="preview of {html.escape(entry["task"])}"></a></td>')
 
@@ -108,7 +117,7 @@ def _row(i, entry, quality_keys):
     notes = [html.escape(x) for x in ([entry["error"]] if entry.get("error") else [])
              + [f"NOT SURE: {u}" for u in entry.get("unsure") or []]]
     warns = entry.get("warnings") or []
-    outs = " ".join(f'<a href="{html.escape(o)}">{html.escape(o)}</a>'
+    outs = " ".join(f'<a href="{_href(o)}">{html.escape(o)}</a>'
                     for o in entry.get("outputs") or []) if status == "ok" else "-"
     cells = [f'<td class="st">{html.escape(status)}</td>', _media(entry),
              f'<td class="path" title="{html.escape(entry.get("input") or "")}">'

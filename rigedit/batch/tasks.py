@@ -53,6 +53,17 @@ def _size(text):
     return w, h
 
 
+def _axes(up, forward):
+    """``autorig --up/--forward``: axes (``y``, ``-x``), at right angles when both are given;
+    a wrong one would fail every task alike, so it is refused before any."""
+    from ..rigging.autorig.orient import check_axes
+
+    try:
+        check_axes(up, forward)
+    except (ValueError, TypeError) as exc:
+        raise BatchUsageError(f"autorig --up/--forward: {exc}") from None
+
+
 def _positive(job, key, value, high):
     if value is None:
         return None
@@ -82,6 +93,7 @@ def check_options(job, options):
     if job == "autorig":
         s["template"] = rig_source(s["template"])
         _choice(job, "method", s["method"], ("heat", "idw"))
+        _axes(s["up"], s["forward"])
         _choice(job, "format", s["format"], ("glb", "folder"))
     elif job == "retarget":
         targets = s["to"] if isinstance(s["to"], (list, tuple)) else [s["to"]] * bool(s["to"])

@@ -1,0 +1,39 @@
+"""Adversarial options: values that would fail every task alike, or the command itself, are
+one line before any work."""
+import pytest
+
+from rigedit.batch.engine import Engine
+from rigedit.batch.inputs import BatchUsageError
+from rigedit.batch.tasks import check_options
+from rigedit.cli.main import main
+
+
+@pytest.mark.parametrize("timeout", [float("nan"), 0, -1, float("inf"), "soon"])
+def test_a_timeout_that_is_no_time_is_refused(timeout):
+    with pytest.raises(BatchUsageError, match="--timeout"):
+        Engine(timeout=timeout)
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"up": "q"}, "expected an axis"),               # every task failed with this ValueError
+    ({"up": "y", "forward": "-y"}, "at right angles"),
+])
+def test_autorig_axes_that_make_no_sense_are_refused(options, message):
+    with pytest.raises(BatchUsageError, match=message):
+        check_options("autorig", options)
+
+
+def test_good_autorig_axes_pass():
+    assert check_options("autorig", {"up": "+Z", "forward": "-x"})["up"] == "+Z"
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--scheduler", "ucx://127.0.0.1:1", "--timeout", "1"], "does not answer"),  # TypeError
+    (["--timeout", "nan"], "--timeout"),
+])
+def test_the_command_says_one_line_and_exits_2(tmp_path, capsys, args, message):
+    out = tmp_path / "out"
+    assert main(["batch", "convert", "humanoid", "--to", "glb", "-o", str(out)] + args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("rigedit: error:") and message in err[0]
+    assert not out.exists()
