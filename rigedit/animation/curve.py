@@ -196,6 +196,16 @@ class Curve:
             pts[idx, 1] += dv
         return self._replace(times=times, values=values, left=left, right=right)
 
+    def shift_range(self, indices):
+        """``(low, high)``: the time offsets (seconds, low <= 0 <= high) by which
+        :meth:`with_keys_moved` moves the keys ``indices`` unclamped. Keys selected on
+        several curves move together by one offset clamped to every curve's range
+        (:func:`rigedit.editor.graph_commands.moved_keys`), so keys of one time stay one."""
+        idx = np.unique(np.asarray(indices, dtype=int).reshape(-1))
+        if len(idx) == 0:
+            return -np.inf, np.inf
+        return _shift_bounds(self.times, idx)
+
     def with_handle(self, index, side, point):
         """Key ``index``'s ``side`` (``left``/``right``) handle at ``point`` (time, value).
 
@@ -316,12 +326,18 @@ class Curve:
         idx = np.unique(np.asarray(indices, dtype=int).reshape(-1))
         times, values = self.times.copy(), self.values.copy()
         left, right = self.left.copy(), self.right.copy()
-        new_t = _spaced(self.times, idx, time_pivot + (times[idx] - time_pivot) * time_factor)
+        # written as x + (x - pivot) (factor - 1), not pivot + (x - pivot) factor: a factor
+        # of 1 (a scale confirmed without moving the mouse) then leaves every time bitwise
+        # where it was, instead of an ulp off (a key an ulp from the same key of the track's
+        # other axes, and an undo step for nothing)
+        t_grow, v_grow = time_factor - 1.0, float(value_factor) - 1.0
+        t = times[idx]
+        new_t = _spaced(self.times, idx, t + (t - time_pivot) * t_grow)
         for pts in (left, right):
-            pts[idx, 0] = new_t + (pts[idx, 0] - times[idx]) * time_factor
-            pts[idx, 1] = value_pivot + (pts[idx, 1] - value_pivot) * value_factor
+            pts[idx, 0] += (new_t - t) + (pts[idx, 0] - t) * t_grow
+            pts[idx, 1] += (pts[idx, 1] - value_pivot) * v_grow
         times[idx] = new_t
-        values[idx] = value_pivot + (values[idx] - value_pivot) * value_factor
+        values[idx] += (values[idx] - value_pivot) * v_grow
         return self._replace(times=times, values=values, left=left, right=right)
 
     def key_near(self, t, v, t_tol, v_tol):
@@ -378,11 +394,16 @@ def _clamp_shift(times, idx, dt):
     """``dt`` clamped so the keys ``idx`` shifted by it stay between their unmoved
     neighbours (:func:`_gaps` apart) and not before time 0 (a clip's start; a key already
     before it does not move further back). The range always holds 0."""
+    return float(np.clip(dt, *_shift_bounds(times, idx)))
+
+
+def _shift_bounds(times, idx):
+    """(low, high) of :func:`_clamp_shift`'s range for the sorted keys ``idx``."""
     lo, hi, gap_lo, gap_hi = _gaps(times, idx)
     t = times[idx]
     floor = np.maximum(lo + gap_lo, np.minimum(t, 0.0))   # clips start at 0
     low, high = np.max(floor - t), np.min(hi - gap_hi - t)
-    return float(np.clip(dt, min(low, 0.0), max(high, 0.0)))
+    return min(float(low), 0.0), max(float(high), 0.0)
 
 
 def _spaced(times, idx, wanted):
@@ -402,9 +423,10 @@ def _spaced(times, idx, wanted):
         gap = min(MIN_GAP, float(np.min(np.diff(t[start:stop]), initial=np.inf)),
                   (ceil - floor) / max(m - 1, 1) if np.isfinite(ceil) else np.inf)
         run = np.clip(out[start:stop], floor, ceil)
-        steps = gap * np.arange(m)
-        # forward: at least a gap after the key before; backward: a gap before the next
-        run = np.minimum(np.maximum.accumulate(run - steps) + steps, ceil)
-        run = np.minimum.accumulate((run - steps)[::-1])[::-1] + steps
+        if np.any(np.diff(run) < gap):   # (else untouched: no rounding of spaced keys)
+            steps = gap * np.arange(m)
+            # forward: at least a gap after the key before; backward: a gap before the next
+            run = np.minimum(np.maximum.accumulate(run - steps) + steps, ceil)
+            run = np.minimum.accumulate((run - steps)[::-1])[::-1] + steps
         out[start:stop] = run
     return out

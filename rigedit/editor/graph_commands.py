@@ -29,8 +29,8 @@ from .clip_edits import edit_clip
 from .events import KeysChanged
 
 __all__ = ["ChannelId", "ChannelView", "channels", "channel_curve", "edit_curves",
-           "CurveDrag", "insert_keys", "delete_keys", "set_interpolation", "set_handle_type",
-           "set_easing", "CHANNEL_KINDS", "AXES"]
+           "CurveDrag", "moved_keys", "insert_keys", "delete_keys", "set_interpolation",
+           "set_handle_type", "set_easing", "CHANNEL_KINDS", "AXES"]
 
 CHANNEL_KINDS = ("translation", "rotation", "scale")
 AXES = "XYZ"
@@ -230,6 +230,26 @@ class CurveDrag:
         self.document.clip_changed(KeysChanged(self.clip.name), True)
 
 
+def moved_keys(base, dt, dv):
+    """Selected keys of several channels moved together: ``base`` is ``{ChannelId: (Curve,
+    key indices)}``; every curve's keys move by the same time offset, ``dt`` clamped to the
+    range of every curve (:meth:`~rigedit.animation.curve.Curve.shift_range`), and ``dv``
+    units. Clamping each curve alone would split keys of one time when one curve has a
+    neighbour in the way (two keys in the timeline where there was one).
+
+    Returns
+    -------
+    dict
+        ChannelId -> the moved Curve.
+    """
+    low, high = -np.inf, np.inf
+    for curve, idx in base.values():
+        a, b = curve.shift_range(idx)
+        low, high = max(low, a), min(high, b)
+    dt = float(np.clip(dt, min(low, 0.0), max(high, 0.0)))
+    return {cid: curve.with_keys_moved(idx, dt, dv) for cid, (curve, idx) in base.items()}
+
+
 def _views(document, ids):
     clip = document.clip
     return {} if clip is None else {cid: channel_curve(clip, cid) for cid in ids}
@@ -254,29 +274,43 @@ def insert_keys(document, ids, t):
     return len(new)
 
 
+def _selected(document, selection):
+    """``{ChannelId: (Curve, sorted unique key indices)}`` of ``selection``'s channels that have
+    a curve in the current clip, each keeping only indices of keys it has: a selection kept
+    from before an undo may name keys the curve no longer has (an IndexError then, and a
+    negative index would pick a key from the end)."""
+    curves = _views(document, selection)
+    out = {}
+    for cid, idx in selection.items():
+        curve = curves.get(cid)
+        if curve is None:
+            continue
+        idx = np.unique(np.asarray(list(idx), dtype=int).reshape(-1))
+        idx = idx[(idx >= 0) & (idx < len(curve))]
+        if len(idx):
+            out[cid] = (curve, idx)
+    return out
+
+
 def delete_keys(document, selection):
     """Delete keys: ``selection`` is ``{ChannelId: [key indices]}``. Returns the number of
     keys deleted."""
-    curves = _views(document, selection)
-    new, count = {}, 0
-    for cid, idx in selection.items():
-        if curves.get(cid) is not None and len(idx):
-            new[cid] = curves[cid].without_keys(idx)
-            count += len(set(idx))
-    if not new:
+    chosen = _selected(document, selection)
+    if not chosen:
         return 0
+    new = {cid: curve.without_keys(idx) for cid, (curve, idx) in chosen.items()}
+    count = sum(len(idx) for _, idx in chosen.values())
     edit_curves(document, new, f"Delete {count} key{'s' if count != 1 else ''}")
     return count
 
 
 def _per_key(document, selection, label, edit):
-    curves = _views(document, selection)
-    new = {cid: edit(curves[cid], list(idx)) for cid, idx in selection.items()
-           if curves.get(cid) is not None and len(idx)}
-    if not new:
+    chosen = _selected(document, selection)
+    if not chosen:
         return 0
-    edit_curves(document, new, label)
-    return sum(len(set(selection[cid])) for cid in new)
+    edit_curves(document, {cid: edit(curve, list(idx)) for cid, (curve, idx) in chosen.items()},
+                label)
+    return sum(len(idx) for _, idx in chosen.values())
 
 
 def set_interpolation(document, selection, name):

@@ -69,8 +69,12 @@ def test_random_moves_and_scales_never_break_the_curve(gaps, chosen, pivot, fact
     if len(idx) == 0:
         idx = np.array([len(times) // 2])
     check_edit(c, c.scaled(idx, pivot, factor, 0.0, 1.0), idx)
+    assert c.scaled(idx, pivot, 1.0, dt, 1.0) == c       # a factor of 1: bitwise the same
+    low, high = c.shift_range(idx)
+    assert low <= 0.0 <= high
     moved = c.with_keys_moved(idx, dt, 1.0)
     check_edit(c, moved, idx)
     shift = moved.times[idx] - c.times[idx]
     np.testing.assert_allclose(shift, shift[0], atol=1e-12)   # one offset for all moved keys
     assert abs(shift[0]) <= abs(dt) + 1e-15                  # clamped, never overshot
+    assert shift[0] == pytest.approx(np.clip(dt, low, high), abs=1e-12)
