@@ -17,7 +17,7 @@ from ..io.mesh import MESH_SUFFIXES
 from ..io.registry import RIG_FILE_SUFFIXES
 
 __all__ = ["BatchUsageError", "JOB_SUFFIXES", "expand_inputs", "rig_source", "content_hash",
-           "quick_stamp"]
+           "quick_stamp", "shown", "name_bytes"]
 
 #: What each job reads from a folder it is given (a rig folder is also an input of the jobs
 #: that read rigs: a folder holding a ``skeleton.json`` is taken whole, not searched).
@@ -41,6 +41,21 @@ class BatchUsageError(ValueError):
     """Bad input found before any work: an option that makes no sense, an input that does not
     exist, an OUTDIR that cannot be written, a scheduler that does not answer. The command
     prints it as one line and exits 2."""
+
+
+def name_bytes(text):
+    """The bytes of a file name as Python holds it: a name that is not UTF-8 (``caf\\xe9.bvh``
+    from an old archive) is ``caf\\udce9``, which ``str.encode`` refuses; a lone surrogate
+    that is no byte of a name (a hand-edited manifest) becomes ``?``."""
+    try:
+        return os.fsencode(str(text))
+    except UnicodeEncodeError:
+        return str(text).encode("utf-8", "replace")
+
+
+def shown(text):
+    """``text`` fit for a UTF-8 page or terminal: a name's undecodable bytes as U+FFFD."""
+    return name_bytes(text).decode("utf-8", "replace")
 
 
 def _is_rig_folder(path):
@@ -235,7 +250,7 @@ def content_hash(source):
     h = hashlib.sha256()
     for f in _files_of(path):
         if f != path:
-            h.update(str(f.relative_to(path)).encode() + b"\0")
+            h.update(name_bytes(f.relative_to(path)) + b"\0")
         with open(f, "rb") as fh:
             for block in iter(lambda: fh.read(1 << 20), b""):
                 h.update(block)

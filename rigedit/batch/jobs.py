@@ -9,6 +9,7 @@ task and returns its quality figures and the reasons a person should look (``uns
 """
 from __future__ import annotations
 
+import copy
 import datetime
 import functools
 import os
@@ -142,17 +143,14 @@ def _retarget(task):
     unsure = [f"unmapped: {part}" for part in unmapped]
     if res.facing_note:
         unsure.append(f"facing: {res.facing_note}")
-    had = target.clips.get(res.clip.name)
-    target.clips[res.clip.name] = res.clip   # the cached target lends itself, then is restored
-    try:
-        clips = None if s["format"] == "folder" else [res.clip.name]
-        save_rig(target, _out(task), clips=clips)
-        _thumbnail(task, target, res.clip)
-    finally:
-        if had is None:
-            del target.clips[res.clip.name]
-        else:
-            target.clips[res.clip.name] = had
+    # the cached target is shared by the tasks of this worker process, several at once when
+    # the worker runs threads (`dask worker` without --nthreads 1): each writes a shallow
+    # copy with its own clips, never the shared one (two clips named "mixamo.com" swapped)
+    result = copy.copy(target)
+    result.clips = {**target.clips, res.clip.name: res.clip}
+    clips = None if s["format"] == "folder" else [res.clip.name]
+    save_rig(result, _out(task), clips=clips)
+    _thumbnail(task, result, res.clip)
     return quality, unsure
 
 

@@ -24,7 +24,7 @@ from importlib import metadata
 from pathlib import Path
 
 from ..io.atomic import write_json
-from .inputs import content_hash, quick_stamp
+from .inputs import content_hash, name_bytes, quick_stamp
 
 __all__ = ["Manifest", "task_id", "rigedit_version", "MANIFEST_DIR"]
 
@@ -49,7 +49,7 @@ def task_id(job, source, target=None):
     """A task's stable id: readable (the input's and target's names) and unique (a hash of
     the job, the input's full path and the target)."""
     key = "\0".join([job, str(source), str(target or "")])
-    digest = hashlib.sha1(key.encode()).hexdigest()[:10]
+    digest = hashlib.sha1(name_bytes(key)).hexdigest()[:10]   # a name may be no UTF-8
     name = Path(str(source)).stem + (f"__{Path(str(target)).stem}" if target else "")
     return f"{job}-{_slug(name)}-{digest}"
 

@@ -18,6 +18,7 @@ from pathlib import Path
 from urllib.parse import quote
 
 from ..io.atomic import atomic_write
+from .inputs import name_bytes, shown
 from .manifest import rigedit_version
 
 __all__ = ["write_report", "needs_look"]
@@ -98,7 +99,7 @@ def _cell(value, sort=None):
 def _href(rel):
     """A path relative to OUTDIR as a relative URL: percent-encoded, so that a name holding
     ``#``, ``%``, ``?`` or ``:`` (``a:b.glb`` read as a scheme) still reaches its file."""
-    return html.escape(quote(Path(rel).as_posix()))
+    return html.escape(quote(name_bytes(Path(rel).as_posix())))
 
 
 def _media(entry):
@@ -174,7 +175,7 @@ def write_report(outdir, job, entries, tasks=None):
 """
     path = Path(outdir) / "report.html"
     with atomic_write(path) as fh:
-        fh.write(page)
+        fh.write(shown(page))   # a name that is no UTF-8: its odd bytes as U+FFFD
     return path
 
 

@@ -197,6 +197,7 @@ def run(job, inputs, out, workers=None, scheduler=None, resume=False, quiet=True
     version = rigedit_version()
     todo = [t for t in tasks if not (resume and manifest.done(t, version))]
     failed = 0
+    finished = set()   # ids of the tasks of ``todo`` that ended in this run
     made = not outdir.exists()
     prepare_outdir(outdir)   # cannot be made or written: said before a cluster starts
     if todo:
@@ -209,20 +210,25 @@ def run(job, inputs, out, workers=None, scheduler=None, resume=False, quiet=True
             raise
     try:
         if todo:
-            failed = _run_tasks(engine, outdir, manifest, todo, quiet)
+            failed = _run_tasks(engine, outdir, manifest, todo, quiet, finished)
     finally:   # also when interrupted: the index and the report show what is done
         engine.close()
         remove_temps(outdir, todo)
         if outdir.is_dir():
-            entries = [e for e in (manifest.read(t["id"]) for t in tasks) if e is not None]
+            # a task to redo that did not end (interrupted) is "not run", not its old entry's
+            # row: that one is of the input or settings before
+            stale = {t["id"] for t in todo} - finished
+            entries = [e for e in (manifest.read(t["id"]) for t in tasks if t["id"] not in stale)
+                       if e is not None]
             manifest.write_index(job)
             report = write_report(outdir, job, entries, tasks=len(tasks))
     return Summary(job, len(tasks), len(todo), len(tasks) - len(todo), failed,
                    time.perf_counter() - t0, outdir, report, outdir / "manifest.json", entries)
 
 
-def _run_tasks(engine, outdir, manifest, todo, quiet):
-    """Run ``todo`` on ``engine``, writing each entry as its task ends; the failed count."""
+def _run_tasks(engine, outdir, manifest, todo, quiet, finished):
+    """Run ``todo`` on ``engine``, writing each entry as its task ends (its id added to the
+    set ``finished``); the failed count."""
     failed = 0
     bar = BatchProgress(len(todo), quiet=quiet)
     try:
@@ -230,6 +236,7 @@ def _run_tasks(engine, outdir, manifest, todo, quiet):
         for task, entry, exc in engine.map(run_task, todo):
             entry = entry if exc is None else _lost_entry(task, exc)
             manifest.write(entry)
+            finished.add(task["id"])
             failed += entry["status"] != "ok"
             bar.update(entry)
     finally:

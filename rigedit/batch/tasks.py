@@ -12,7 +12,7 @@ import hashlib
 import math
 from pathlib import Path
 
-from .inputs import BatchUsageError, rig_source
+from .inputs import BatchUsageError, name_bytes, rig_source
 from .manifest import MANIFEST_DIR, task_id
 
 __all__ = ["JOBS", "check_options", "plan", "THUMBS_DIR"]
@@ -152,7 +152,7 @@ MAX_BASE_BYTES = 160
 
 def _short(base):
     """``base`` cut to :data:`MAX_BASE_BYTES` bytes at a character's boundary."""
-    return base.encode()[:MAX_BASE_BYTES].decode(errors="ignore")
+    return name_bytes(base)[:MAX_BASE_BYTES].decode(errors="ignore")
 
 
 def _unique_bases(job, pairs, settings):
@@ -167,12 +167,12 @@ def _unique_bases(job, pairs, settings):
         seen[b] = seen.get(b, 0) + 1
 
     def clash(base):
-        return (seen[base] > 1 or len(base.encode()) > MAX_BASE_BYTES
+        return (seen[base] > 1 or len(name_bytes(base)) > MAX_BASE_BYTES
                 or any(Path(o).parts[0] in RESERVED for o in _outputs(job, base, settings)))
 
     def tag(source, target):
         key = str(source) + (f"\0{target}" if target else "")
-        return hashlib.sha1(key.encode()).hexdigest()[:6]
+        return hashlib.sha1(name_bytes(key)).hexdigest()[:6]
 
     return [f"{_short(b)}-{tag(s, t)}" if clash(b) else b for b, (s, t) in zip(bases, pairs)]
 

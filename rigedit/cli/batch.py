@@ -95,14 +95,16 @@ _NOT_OPTIONS = {"command", "job", "inputs", "output", "workers", "scheduler", "r
 def cmd_batch(args):
     """Run the batch; 1 when a task failed (saying how many), else 0."""
     from ..batch import run
+    from ..batch.inputs import shown
 
     options = {k: v for k, v in vars(args).items() if k not in _NOT_OPTIONS}
     quiet = getattr(args, "quiet", False)
     summary = run(args.job, args.inputs, args.output, workers=args.workers,
                   scheduler=args.scheduler, resume=args.resume, quiet=quiet,
                   timeout=args.timeout, **options)
+    report = shown(str(summary.report))   # stdout takes no undecodable bytes of a name
     print(f"{summary.tasks} tasks: {summary.ran} run, {summary.skipped} skipped (done before), "
-          f"{summary.failed} failed; {summary.seconds:.1f} s; report {summary.report}")
+          f"{summary.failed} failed; {summary.seconds:.1f} s; report {report}")
     if summary.failed:
         print(f"rigedit: error: {summary.failed} of {summary.ran} tasks failed (their errors "
               f"are in {summary.report})", file=sys.stderr)

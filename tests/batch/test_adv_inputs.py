@@ -67,8 +67,8 @@ def test_outdir_inside_the_searched_folder_is_left_out(tmp_path):
 
 
 @pytest.mark.parametrize("name", ["my walk.bvh", "marche_é_歩く.bvh", "-walk.bvh", "#1 walk.bvh",
-                                  "100% walk.bvh", "it's \"walk\".bvh", "<script>alert(1)<\\script>.bvh",
-                                  "walk[1].bvh"])
+                                  "100% walk.bvh", "it's \"walk\".bvh",
+                                  "<script>alert(1)<\\script>.bvh", "walk[1].bvh"])
 def test_unusual_names_are_found_once_by_folder_glob_and_path(tmp_path, name):
     f = _touch(tmp_path / "lib" / name)
     got = expand_inputs("retarget", [tmp_path / "lib", f, f"{tmp_path}/lib/*.bvh"])

@@ -32,7 +32,8 @@ def done(tmp_path):
 @pytest.mark.parametrize("field, value", [
     ("inputs", ["SRC"]),           # a list of the input's name: resume raised TypeError
     ("quality", ["frames"]),       # the report raised AttributeError
-    ("input", 7), ("status", None), ("status", 'ok" onclick="alert(1)'), ("outputs", "a.glb"), ("unsure", "left arm"),
+    ("input", 7), ("status", None), ("status", 'ok" onclick="alert(1)'), ("outputs", "a.glb"),
+    ("unsure", "left arm"),
     ("warnings", [1, 2]), ("target", ["hero"]), ("seconds", "fast"), ("error", {"x": 1}),
 ])
 def test_an_entry_of_the_wrong_shape_is_no_entry(done, field, value):
