@@ -67,7 +67,11 @@ def solve_u(x, t, iterations=30):
     tol = 1e-12 * span
     for _ in range(iterations):
         f = ((a * u + b) * u + c) * u + x0 - t
-        if np.all(np.abs(f) <= tol):
+        # a converged sample stays where it is while others iterate: its next Newton step
+        # rounds to u itself, which lies on its bracket's edge and would read as leaving it
+        # (a bisection would throw the root away to the middle of a wide bracket)
+        active = np.abs(f) > tol
+        if not active.any():
             break
         lo = np.where(f < 0, u, lo)
         hi = np.where(f > 0, u, hi)
@@ -75,7 +79,7 @@ def solve_u(x, t, iterations=30):
         with np.errstate(divide="ignore", invalid="ignore"):
             step = u - f / d
         bad = ~np.isfinite(step) | (step <= lo) | (step >= hi)
-        u = np.where(bad, 0.5 * (lo + hi), step)
+        u = np.where(active, np.where(bad, 0.5 * (lo + hi), step), u)
     return u
 
 
