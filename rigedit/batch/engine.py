@@ -85,15 +85,21 @@ class Engine:
     def __enter__(self):
         return self.start()
 
-    def start(self):
-        """Start the local cluster or connect to the scheduler; returns self."""
+    def start(self, tasks=None):
+        """Start the local cluster or connect to the scheduler; returns self.
+
+        ``tasks``: how many will run; a local cluster starts no more worker processes than
+        that (each imports rigedit and the renderer: 3 files on a 64-core machine are not
+        worth 64 processes)."""
         import dask
         import distributed
 
         if self.scheduler is None:
+            n = self.workers or os.cpu_count() or 1
+            n = min(n, tasks) if tasks else n
             with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
                 self.cluster = distributed.LocalCluster(
-                    n_workers=self.workers or os.cpu_count() or 1, threads_per_worker=1,
+                    n_workers=n, threads_per_worker=1,
                     processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL)
             self.client = distributed.Client(self.cluster)
         else:

@@ -258,11 +258,21 @@ def content_hash(source):
 
 
 def quick_stamp(source):
-    """``[size, mtime_ns]`` of a file (a folder: summed over its files), the cheap check a
-    resume makes before hashing again; None when it cannot be read."""
+    """``[size, mtime_ns]`` of a file, the cheap check a resume makes before hashing again;
+    None when it cannot be read. A folder: the summed size, the latest time and a digest of
+    every file's relative name, size and time, since a renamed file (``clips/walk.json`` to
+    ``clips/run.json``: a clip renamed) or one copied in with its old time keeps the sum and
+    the latest time."""
     path = resolve_rig_path(str(source)) if str(source) in BUNDLED else Path(source)
     try:
-        stats = [f.stat() for f in _files_of(path)]
+        files = _files_of(path)
+        stats = [f.stat() for f in files]
     except OSError:
         return None
-    return [sum(s.st_size for s in stats), max((s.st_mtime_ns for s in stats), default=0)]
+    stamp = [sum(s.st_size for s in stats), max((s.st_mtime_ns for s in stats), default=0)]
+    if path.is_dir():
+        h = hashlib.sha1()
+        for f, s in zip(files, stats):
+            h.update(name_bytes(f.relative_to(path)) + f"\0{s.st_size}\0{s.st_mtime_ns}\0".encode())
+        stamp.append(h.hexdigest()[:16])
+    return stamp

@@ -29,13 +29,15 @@ THUMB_FRAMES, THUMB_SIZE = 8, (192, 192)
 
 def one_line(exc):
     """An exception as one line: a ``RigFileError``'s own words (they name the file), else
-    its type and message, whitespace collapsed, at most 300 characters."""
+    its type and message, whitespace collapsed, at most 300 characters (a longer one loses
+    its middle)."""
     from ..errors import RigFileError
 
     text = " ".join(str(exc).split())
     if not isinstance(exc, (RigFileError, OSError)) or not text:
         text = f"{type(exc).__name__}: {text}" if text else type(exc).__name__
-    return text[:300]
+    # too long: the middle goes, not the end (a deep path would push the problem out)
+    return text if len(text) <= 300 else f"{text[:140]} ... {text[-155:]}"
 
 
 def _load(source):
@@ -78,10 +80,10 @@ def _thumbnail(task, rig, clip):
     from ..render.recorder import record_clip
 
     path = Path(task["outdir"]) / task["thumbnail"]
-    path.parent.mkdir(exist_ok=True)
     duration = clip.duration if clip is not None and clip.duration > 0 else 1.0
     frames = THUMB_FRAMES if clip is not None else 1
     try:
+        path.parent.mkdir(exist_ok=True)   # a thumbs/ that cannot be made: a warning too
         record_clip(rig, clip, path, fps=frames / duration, duration=duration, size=THUMB_SIZE)
     except Exception as exc:   # no OpenGL on this worker, say: the output itself is fine
         warnings.warn(f"thumbnail not made: {one_line(exc)}")

@@ -202,7 +202,7 @@ def run(job, inputs, out, workers=None, scheduler=None, resume=False, quiet=True
     prepare_outdir(outdir)   # cannot be made or written: said before a cluster starts
     if todo:
         try:
-            engine.start()
+            engine.start(tasks=len(todo))
         except BaseException:   # a scheduler that does not answer: leave no trace
             if made:
                 with contextlib.suppress(OSError):

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import os
 from pathlib import Path
 
 from .inputs import BatchUsageError, name_bytes, rig_source
@@ -64,6 +65,18 @@ def _axes(up, forward):
         raise BatchUsageError(f"autorig --up/--forward: {exc}") from None
 
 
+def _joint_map(path):
+    """``retarget --map``: a JSON joint map (its names are checked against each task's
+    skeletons there); one that is no map would fail every task alike."""
+    from ..errors import RigFileError
+    from ..rigging.retarget.map_files import load_map
+
+    try:
+        load_map(path)
+    except RigFileError as exc:
+        raise BatchUsageError(f"retarget --map: {exc}") from None
+
+
 def _positive(job, key, value, high):
     if value is None:
         return None
@@ -102,6 +115,7 @@ def check_options(job, options):
         s["to"] = sorted({rig_source(t) for t in targets})
         if s["map"] is not None:
             s["map"] = rig_source(s["map"])
+            _joint_map(s["map"])
         _choice(job, "format", s["format"], ("glb", "folder"))
     elif job == "render":
         if not s["clip"]:
@@ -188,6 +202,12 @@ def plan(job, sources, outdir, settings):
     outdir : Path
     settings : dict
         :func:`check_options`'s result.
+
+    Raises
+    ------
+    BatchUsageError
+        A task would write over a file some task reads (``rigedit batch compress *.glb -o .``
+        replaced the originals with their lossy copies).
     """
     pairs = _pairs(job, sources, settings)
     tasks = []
@@ -202,4 +222,18 @@ def plan(job, sources, outdir, settings):
         tasks.append({"id": tid, "job": job, "input": str(source), "target": target,
                       "reads": reads, "settings": task_settings, "outputs": outputs,
                       "thumbnail": thumb, "outdir": str(outdir)})
+    _check_no_overwrite(tasks, outdir)
     return tasks
+
+
+def _check_no_overwrite(tasks, outdir):
+    """``BatchUsageError`` when an output (or a preview) of a task is a file a task reads."""
+    real = Path(os.path.realpath(outdir))
+    written = {real / rel for t in tasks
+               for rel in t["outputs"] + ([t["thumbnail"]] if t["thumbnail"] else [])}
+    for t in tasks:
+        for source in t["reads"]:
+            path = Path(os.path.realpath(source)) if os.path.isabs(source) else None
+            if path in written:
+                raise BatchUsageError(f"{source}: a task would write its output over this "
+                                      f"input (it is in OUTDIR); give another -o")

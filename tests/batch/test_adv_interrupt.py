@@ -13,7 +13,7 @@ class _Engine:
     def __init__(self, *args, **kwargs):
         pass
 
-    def start(self):
+    def start(self, tasks=None):
         return self
 
     def close(self):

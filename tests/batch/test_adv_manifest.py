@@ -119,3 +119,20 @@ def test_an_output_another_batch_wrote_since_under_the_same_name_runs_again(tmp_
     assert tasks[0]["outputs"] == tasks[1]["outputs"] == ["hero.bvh"]
     assert manifest.done(tasks[1], rigedit_version())
     assert not manifest.done(tasks[0], rigedit_version())
+
+
+def test_a_file_renamed_inside_a_rig_folder_is_a_change(tmp_path):
+    # a rename keeps the folder's summed size and latest time: the stamp said "unchanged"
+    # and a resume skipped the task although the clip had a new name
+    from rigedit.batch.inputs import content_hash, quick_stamp
+    from rigedit.batch.manifest import _same_content
+
+    rig = tmp_path / "fox"
+    (rig / "clips").mkdir(parents=True)
+    (rig / "skeleton.json").write_text("{}")
+    (rig / "clips" / "walk.json").write_text("[1]")
+    os.utime(rig / "clips" / "walk.json", ns=(1, 10**18))   # older than skeleton.json
+    recorded = {"hash": content_hash(rig), "stamp": quick_stamp(rig)}
+    assert _same_content(str(rig), recorded)
+    os.rename(rig / "clips" / "walk.json", rig / "clips" / "run.json")
+    assert not _same_content(str(rig), recorded)

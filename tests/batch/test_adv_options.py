@@ -37,3 +37,21 @@ def test_the_command_says_one_line_and_exits_2(tmp_path, capsys, args, message):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("rigedit: error:") and message in err[0]
     assert not out.exists()
+
+
+@pytest.mark.parametrize("text, message", [("{", "invalid JSON"), ("[1, 2]", "expected an object"),
+                                           (None, "cannot read")])
+def test_a_joint_map_that_is_no_map_is_refused_before_any_task(tmp_path, text, message):
+    path = tmp_path / "map.json"
+    if text is None:
+        path.mkdir()   # a folder given as the map
+    else:
+        path.write_text(text)
+    with pytest.raises(BatchUsageError, match=f"retarget --map: .*{message}"):
+        check_options("retarget", {"to": ["humanoid"], "map": str(path)})
+
+
+def test_a_good_joint_map_passes(tmp_path):
+    path = tmp_path / "map.json"
+    path.write_text('{"Hips": "Hips"}')
+    assert check_options("retarget", {"to": ["humanoid"], "map": str(path)})["map"] == str(path)

@@ -23,7 +23,7 @@ def test_two_targets_with_one_name_do_not_share_an_output(tmp_path):
 
 
 def test_an_input_named_like_the_manifest_or_the_thumbnails_gets_its_own_name(tmp_path):
-    inputs = [tmp_path / n for n in ("manifest.glb", "thumbs.glb", "report.html.glb",
+    inputs = [tmp_path / "in" / n for n in ("manifest.glb", "thumbs.glb", "report.html.glb",
                                      "manifest.json.bvh", "walk.glb")]
     for job, options in (("convert", {"to": "folder"}), ("convert", {"to": "glb"}),
                          ("autorig", {"format": "folder"})):
@@ -50,3 +50,22 @@ def test_a_render_clip_with_a_slash_stays_in_outdir(tmp_path):
     tasks = plan("render", [tmp_path / "hero.glb"], tmp_path,
                  check_options("render", {"clip": "Take 001/../../run"}))
     assert all("/" not in o for o in tasks[0]["outputs"])
+
+
+def test_an_output_over_an_input_is_refused_before_any_work(tmp_path):
+    # `rigedit batch compress *.glb -o .` wrote each lossy result over its original
+    import pytest
+
+    from rigedit.batch.inputs import BatchUsageError
+
+    hero = tmp_path / "hero.glb"
+    hero.write_text("x")
+    for job, options in (("compress", {"max_error": 1.0}), ("convert", {"to": "glb"})):
+        with pytest.raises(BatchUsageError, match="hero.glb: a task would write its output"):
+            plan(job, [hero], tmp_path, check_options(job, options))
+    # through a symlinked OUTDIR too
+    (tmp_path / "link").symlink_to(tmp_path)
+    with pytest.raises(BatchUsageError, match="over this input"):
+        plan("convert", [hero], tmp_path / "link", check_options("convert", {"to": "glb"}))
+    # into another folder, or to another suffix, it is fine
+    assert plan("convert", [hero], tmp_path, check_options("convert", {"to": "bvh"}))

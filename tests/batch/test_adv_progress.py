@@ -19,3 +19,21 @@ def test_a_lost_task_is_one_progress_line_not_a_crash(tmp_path):
     assert lines[0].startswith(f"[1/2] {tasks[0]['id']}: failed (its worker died")
     assert "no time; done 0, failed 1, remaining 1" in lines[0]
     assert "0.2 s; done 1, failed 1, remaining 0" in lines[1]
+
+
+def test_a_deep_path_does_not_push_the_problem_out_of_the_one_line_error(tmp_path):
+    # the error was cut at 300 characters: a 400-character path left only the path
+    from batch_helpers import broken_bvh
+    from rigedit.batch.jobs import run_task
+
+    deep = tmp_path.joinpath(*["a_rather_long_folder_name"] * 16)
+    deep.mkdir(parents=True)
+    entries = []
+    for folder in (tmp_path, deep):
+        (task,) = plan("retarget", [broken_bvh(folder)], tmp_path,
+                       check_options("retarget", {"to": ["humanoid"], "thumbnails": False}))
+        entries.append(run_task(task))
+    short, long_ = (e["error"] for e in entries)
+    problem = short.split("broken.bvh: ", 1)[1]
+    assert len(str(deep)) > 400 and len(long_) <= 300 and "\n" not in long_
+    assert long_.endswith(problem) and long_.startswith(str(tmp_path)[:100])

@@ -68,3 +68,22 @@ def test_a_few_hundred_tasks_write_a_usable_report_and_index(tmp_path):
     t1 = time.perf_counter()
     again = batch.run("noop", [f"{lib}/*.bvh"], tmp_path / "out", workers=1, resume=True)
     assert again.skipped == 300 and time.perf_counter() - t1 < max(5.0, took)
+
+
+def test_a_local_cluster_starts_no_more_workers_than_tasks(tmp_path, monkeypatch):
+    # --workers 4 (or one per core by default) for 2 files started 4 processes, each
+    # importing rigedit and the renderer
+    import distributed
+
+    asked = []
+    real = distributed.LocalCluster
+
+    def spy(*args, **kwargs):
+        asked.append(kwargs["n_workers"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(distributed, "LocalCluster", spy)
+    for name in ("a.bvh", "b.bvh"):
+        (tmp_path / name).write_bytes(b"x")
+    s = batch.run("noop", [f"{tmp_path}/*.bvh"], tmp_path / "out", workers=4)
+    assert (s.ran, s.failed) == (2, 0) and asked == [2]
