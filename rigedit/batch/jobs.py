@@ -67,7 +67,8 @@ def _pick_clip(rig, name, what):
     names = sorted(rig.clips)
     pick = name if name is not None else next(iter(names), None)
     if pick not in rig.clips:
-        raise RigFileError(what, f"expected a clip {name or ''}, got "
+        wanted = f"the clip {name!r}" if name is not None else "a clip"
+        raise RigFileError(what, f"expected {wanted}, got "
                                  f"{'clips ' + ', '.join(names) if names else 'none'}")
     return rig.clips[pick]
 

@@ -37,3 +37,14 @@ def test_a_deep_path_does_not_push_the_problem_out_of_the_one_line_error(tmp_pat
     problem = short.split("broken.bvh: ", 1)[1]
     assert len(str(deep)) > 400 and len(long_) <= 300 and "\n" not in long_
     assert long_.endswith(problem) and long_.startswith(str(tmp_path)[:100])
+
+
+def test_a_missing_clip_error_names_what_was_wanted(tmp_path):
+    # was "expected a clip , got none" / "expected a clip nope, got clips ..."
+    from rigedit.batch.jobs import run_task
+
+    (task,) = plan("convert", ["humanoid"], tmp_path,
+                   check_options("convert", {"to": "bvh", "clip": "nope", "thumbnails": False}))
+    error = run_task(task)["error"]
+    assert error.startswith("humanoid") and "expected the clip 'nope', got clips " in error
+    assert "walk" in error
