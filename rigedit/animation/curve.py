@@ -43,6 +43,8 @@ AUTO_TYPES = ("auto", "auto_clamped", "vector")
 KEY_TOLERANCE = 1e-6
 #: Easing presets make the eased handle this fraction of its segment long (flat).
 EASE_LENGTH = 0.6
+#: What a handle type becomes when its handle must stay where it is (as a drag does).
+_FROZEN = {"auto": "aligned", "auto_clamped": "aligned", "vector": "free"}
 
 
 def _names(values, allowed, count, what, default):
@@ -239,16 +241,28 @@ class Curve:
                 pts[other][i] = key + d / n * length
         return self._replace(left=pts["left"], right=pts["right"], left_type=lt, right_type=rt)
 
-    def with_key(self, t, value=None, tol=KEY_TOLERANCE):
+    def with_key(self, t, value=None, tol=KEY_TOLERANCE, keep_shape=False):
         """A key inserted at ``t`` (``value``: the curve's value there when None; a key already
         within ``tol`` seconds of ``t`` takes the value instead). New keys are bezier,
-        auto_clamped."""
+        auto_clamped.
+
+        ``keep_shape`` (the graph editor's Insert): the curve plays as before. A bezier
+        segment is split where ``t`` falls on it (de Casteljau: the new key's handles
+        aligned, the neighbours' handles on that side shortened along themselves), a linear
+        or constant one gives the new key its interpolation, and the neighbouring keys'
+        automatic handles are kept where they are (auto and auto_clamped become aligned,
+        vector free, as a drag does), since recomputed against the new key they would bend
+        the segments beside it by degrees. A ``value`` other than the curve's moves the new
+        key (and its handles) to it.
+        """
         t = float(t)
         v = self.sample(t) if value is None else float(value)
         near = np.flatnonzero(np.abs(self.times - t) <= tol)
         if len(near):
             return self.with_keys_moved(near, 0.0, v - self.values[near[0]])
         j = int(np.searchsorted(self.times, t))
+        if keep_shape:
+            return self._split(j, t, v)
         flat = np.array([t, v])
 
         def ins(a, x):
@@ -258,6 +272,43 @@ class Curve:
                      ins(self.interpolation, "bezier"), ins(self.left, flat),
                      ins(self.right, flat), ins(self.left_type, "auto_clamped"),
                      ins(self.right_type, "auto_clamped"))
+
+    def _split(self, j, t, v):
+        """:meth:`with_key` with ``keep_shape``: a key at ``t`` (index ``j`` once inserted)."""
+        left, right = self.left.copy(), self.right.copy()
+        lt, rt = self.left_type.copy(), self.right_type.copy()
+        for i in (j - 1, j):
+            if 0 <= i < len(self):
+                for types in (lt, rt):
+                    types[i] = _FROZEN.get(types[i], types[i])
+        interp, new_l, new_r = "bezier", np.array([t, v]), np.array([t, v])
+        kinds = ("auto_clamped", "auto_clamped")
+        codes = self.interpolation.copy()
+        # beyond the ends the curve holds its end value: a linear segment to the new key
+        # holds it too (a bezier one would bend through the old end key's outer handle)
+        if j == 0:
+            interp = "linear"
+        elif j == len(self):
+            codes[-1] = "linear"
+        else:
+            k = j - 1
+            interp = self.interpolation[k]
+            if interp == "bezier":
+                p = self.segments()[k]
+                u = float(solve_u(p[None, :, 0], np.array([t]))[0])
+                a, b, c = (p[:-1] + (p[1:] - p[:-1]) * u)     # de Casteljau, level 1
+                d, e = a + (b - a) * u, b + (c - b) * u
+                key = d + (e - d) * u
+                shift = np.array([0.0, v - key[1]])
+                right[k], left[k + 1] = a, c
+                new_l, new_r = d + shift, e + shift
+                kinds = ("aligned", "aligned")
+
+        def ins(arr, x):
+            return np.insert(arr, j, x, axis=0)
+
+        return Curve(ins(self.times, t), ins(self.values, v), ins(codes, interp),
+                     ins(left, new_l), ins(right, new_r), ins(lt, kinds[0]), ins(rt, kinds[1]))
 
     def without_keys(self, indices):
         """The curve without keys ``indices``; None when no key is left."""

@@ -269,7 +269,7 @@ def insert_keys(document, ids, t):
             rest = _rest_values(document.skeleton, cid.joint, cid.channel)[cid.axis]
             new[cid] = Curve([t], [rest])
         else:
-            new[cid] = view.curve.with_key(t, float(view.sample([t])[0]))
+            new[cid] = view.curve.with_key(t, float(view.sample([t])[0]), keep_shape=True)
     edit_curves(document, new, f"Insert keys at {t:.2f}s")
     return len(new)
 

@@ -18,7 +18,8 @@ def bisect_sample(curve, ts, steps=200):
 
     def at(p, u):
         w = 1 - u
-        return w ** 3 * p[:, 0] + 3 * w * w * u * p[:, 1] + 3 * w * u * u * p[:, 2] + u ** 3 * p[:, 3]
+        return (w ** 3 * p[:, 0] + 3 * w * w * u * p[:, 1] + 3 * w * u * u * p[:, 2]
+                + u ** 3 * p[:, 3])
 
     lo, hi = np.zeros(len(ts)), np.ones(len(ts))
     for _ in range(steps):
