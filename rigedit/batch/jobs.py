@@ -49,14 +49,18 @@ def _load(source):
 
 
 @functools.lru_cache(maxsize=8)
-def _cached_rig(source, stamp):
-    """A target or template read once per worker process (a worker runs one task at a time;
-    ``stamp`` makes a changed file a new read)."""
+def _cached_rig(source, digest):
+    """A target or template read once per worker process; ``digest`` (its content hash)
+    makes a changed file a new read."""
     return _load(source)
 
 
-def _rig_option(source):
-    return _cached_rig(source, tuple(quick_stamp(source) or ()))
+def _rig_option(source, task):
+    """The target or template ``source`` of ``task``, cached by the content hash the task
+    recorded for it (a worker of a running cluster outlives batches: a file edited with its
+    size and time kept, as ``cp -p`` or a tar leaves it, was served from the cache)."""
+    digest = (task.get("hashes") or {}).get(source)
+    return _cached_rig(source, digest or tuple(quick_stamp(source) or ()))
 
 
 def _pick_clip(rig, name, what):
@@ -99,7 +103,7 @@ def _autorig(task):
     from ..rigging.autorig.pipeline import autorig
 
     s = task["settings"]
-    template = _rig_option(s["template"])
+    template = _rig_option(s["template"], task)
     rig = autorig(task["input"], template=template, up=s["up"], forward=s["forward"],
                   weights=s["method"], clips=s["clips"])
     report = rig.autorig_report
@@ -127,7 +131,7 @@ def _retarget(task):
 
     s = task["settings"]
     source = _load(task["input"])
-    target = _rig_option(task["target"])
+    target = _rig_option(task["target"], task)
     clip = _pick_clip(source, s["clip"], task["input"])
     mapping = load_map(s["map"], source.skeleton, target.skeleton) if s["map"] else None
     res = retarget_result(source, clip, target, mapping, None, source_what=task["input"],
@@ -219,7 +223,8 @@ def run_task(task):
         warnings.simplefilter("always")
         try:
             entry["inputs"] = _reads(task)
-            entry["quality"], entry["unsure"] = _JOBS[task["job"]](task)
+            hashes = {src: read["hash"] for src, read in entry["inputs"].items()}
+            entry["quality"], entry["unsure"] = _JOBS[task["job"]]({**task, "hashes": hashes})
             # what this task wrote, so that a resume can tell it from a file another batch
             # wrote later under the same name into the same OUTDIR
             entry["output_stamps"] = {o: quick_stamp(Path(task["outdir"]) / o)

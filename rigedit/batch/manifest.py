@@ -45,11 +45,12 @@ def _slug(text, limit=40):
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)[:limit].strip("._") or "task"
 
 
-def task_id(job, source, target=None):
+def task_id(job, source, target=None, digits=10):
     """A task's stable id: readable (the input's and target's names) and unique (a hash of
-    the job, the input's full path and the target)."""
+    the job, the input's full path and the target, ``digits`` hex digits of it: a plan
+    gives the rare pair of tasks whose 10 digits agree more)."""
     key = "\0".join([job, str(source), str(target or "")])
-    digest = hashlib.sha1(name_bytes(key)).hexdigest()[:10]   # a name may be no UTF-8
+    digest = hashlib.sha1(name_bytes(key)).hexdigest()[:digits]   # a name may be no UTF-8
     name = Path(str(source)).stem + (f"__{Path(str(target)).stem}" if target else "")
     return f"{job}-{_slug(name)}-{digest}"
 

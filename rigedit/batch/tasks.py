@@ -11,6 +11,7 @@ from __future__ import annotations
 import hashlib
 import math
 import os
+from collections import Counter
 from pathlib import Path
 
 from .inputs import BatchUsageError, name_bytes, rig_source
@@ -176,19 +177,22 @@ def _unique_bases(job, pairs, settings):
     or that is too long for a file name gets a short hash of the input's path (and the
     target's), so no task overwrites another's output or the manifest."""
     bases = [Path(str(s)).stem + (f"__{Path(str(t)).stem}" if t else "") for s, t in pairs]
-    seen = {}
-    for b in bases:
-        seen[b] = seen.get(b, 0) + 1
+    seen = Counter(bases)
 
     def clash(base):
         return (seen[base] > 1 or len(name_bytes(base)) > MAX_BASE_BYTES
                 or any(Path(o).parts[0] in RESERVED for o in _outputs(job, base, settings)))
 
-    def tag(source, target):
+    def tag(source, target, digits):
         key = str(source) + (f"\0{target}" if target else "")
-        return hashlib.sha1(name_bytes(key)).hexdigest()[:6]
+        return hashlib.sha1(name_bytes(key)).hexdigest()[:digits]
 
-    return [f"{_short(b)}-{tag(s, t)}" if clash(b) else b for b, (s, t) in zip(bases, pairs)]
+    out = [f"{_short(b)}-{tag(s, t, 6)}" if clash(b) else b for b, (s, t) in zip(bases, pairs)]
+    # 6 hex digits are 24 bits: 20,000 files named take.bvh gave 10 pairs one output name
+    # (or a name may be another input's literally); those get the whole hash
+    again = Counter(out)
+    return [f"{_short(b)}-{tag(s, t, 40)}" if again[o] > 1 else o
+            for o, b, (s, t) in zip(out, bases, pairs)]
 
 
 def plan(job, sources, outdir, settings):
@@ -210,9 +214,11 @@ def plan(job, sources, outdir, settings):
         replaced the originals with their lossy copies).
     """
     pairs = _pairs(job, sources, settings)
+    ids = [task_id(job, s, t) for s, t in pairs]
+    twice = Counter(ids)
+    ids = [task_id(job, s, t, 40) if twice[i] > 1 else i for i, (s, t) in zip(ids, pairs)]
     tasks = []
-    for (source, target), base in zip(pairs, _unique_bases(job, pairs, settings)):
-        tid = task_id(job, source, target)
+    for (source, target), base, tid in zip(pairs, _unique_bases(job, pairs, settings), ids):
         reads = [str(source)] + ([target] if target else [])
         reads += [settings[k] for k in ("template", "map") if settings.get(k)]
         task_settings = {k: v for k, v in settings.items() if k != "to" or job != "retarget"}

@@ -59,7 +59,10 @@ def test_a_retarget_never_changes_the_target_its_worker_shares(tmp_path, monkeyp
     (motion,) = make_motions(tmp_path / "in", 1)
     (task,) = plan("retarget", [motion], tmp_path, check_options(
         "retarget", {"to": ["humanoid"], "thumbnails": False}))
-    shared = jobs._rig_option("humanoid")
+    from rigedit.batch.inputs import content_hash
+
+    # the very object the task gets: cached under the hash the task records
+    shared = jobs._rig_option("humanoid", {"hashes": {"humanoid": content_hash("humanoid")}})
     before = dict(shared.clips)
     seen = []
     real = save.save_rig
@@ -74,3 +77,31 @@ def test_a_retarget_never_changes_the_target_its_worker_shares(tmp_path, monkeyp
     (is_shared, untouched, clips), = seen
     assert not is_shared and untouched
     assert shared.clips == before
+
+
+def test_a_target_edited_with_its_size_and_time_kept_is_read_again(tmp_path):
+    # a worker's cache was keyed by size and mtime: an edit that kept both (cp -p, a tar)
+    # retargeted onto the old target while the entry recorded the new one's hash
+    from batch_helpers import make_motions
+    from rigedit.batch.inputs import quick_stamp
+
+    target = tmp_path / "hero"
+    rigedit.save_rig(rigedit.load_rig("humanoid"), target)   # a rig folder
+    (motion,) = make_motions(tmp_path / "in", 1)
+    settings = check_options("retarget", {"to": [str(target)], "thumbnails": False})
+    (task,) = plan("retarget", [motion], tmp_path / "out", settings)
+    (tmp_path / "out").mkdir()
+    skeleton = target / "skeleton.json"
+    heights = []
+    for edit in (False, True):
+        if edit:   # the hips 10 cm lower, the file's size and time as they were
+            st = skeleton.stat()
+            skeleton.write_text(skeleton.read_text().replace("0.982647735", "0.882647735", 1))
+            os.utime(skeleton, ns=(st.st_atime_ns, st.st_mtime_ns))
+            assert quick_stamp(target) == stamp   # what the cache was keyed by
+        stamp = quick_stamp(target)
+        entry = run_task(task)
+        assert entry["status"] == "ok", entry["error"]
+        out = rigedit.load_rig(tmp_path / "out" / task["outputs"][0]).skeleton
+        heights.append(round(float(out.rest_translation[out.index["Hips"], 1]), 6))
+    assert heights == [0.982648, 0.882648]

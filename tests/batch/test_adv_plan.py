@@ -69,3 +69,33 @@ def test_an_output_over_an_input_is_refused_before_any_work(tmp_path):
         plan("convert", [hero], tmp_path / "link", check_options("convert", {"to": "glb"}))
     # into another folder, or to another suffix, it is fine
     assert plan("convert", [hero], tmp_path, check_options("convert", {"to": "bvh"}))
+
+
+def test_many_inputs_of_one_name_never_share_an_output(tmp_path):
+    # the 6-digit tag is 24 bits: 20,000 folders each with a take.bvh gave 10 pairs of tasks
+    # one output name, each pair's second overwriting the first's
+    import time
+
+    srcs = [tmp_path / f"d{i:05d}" / "take.bvh" for i in range(20000)]
+    t0 = time.perf_counter()
+    tasks = plan("convert", srcs, tmp_path / "out", check_options("convert", {"to": "glb"}))
+    took = time.perf_counter() - t0
+    outs = _outputs(tasks)
+    assert len(set(outs)) == len(outs) == 20000
+    assert sum(len(o) > len("take-123456.glb") for o in outs) >= 2 * 10   # the lengthened
+    assert len({t["id"] for t in tasks}) == 20000
+    assert took < 30   # no quadratic step (about 1 s here)
+
+
+def test_two_task_ids_that_agree_get_longer_digests(tmp_path, monkeypatch):
+    # 10 hex digits are 40 bits: a million tasks make a pair likely; a pair shared one
+    # manifest entry and one Dask key
+    from rigedit.batch import tasks as tasks_module
+    from rigedit.batch.manifest import task_id
+
+    monkeypatch.setattr(tasks_module, "task_id", lambda job, s, t=None, digits=10:
+                        "noop-x-0000000000" if digits == 10 else task_id(job, s, t, digits))
+    got = plan("noop", [tmp_path / "a.bvh", tmp_path / "b.bvh"], tmp_path,
+               check_options("noop", {}))
+    ids = [t["id"] for t in got]
+    assert len(set(ids)) == 2 and all(len(i.rsplit("-", 1)[1]) == 40 for i in ids)
