@@ -113,6 +113,9 @@ def _best_segments(track, euler, order, slopes):
     chosen = np.stack(candidates)[best, np.arange(len(dt))]
     out = slopes.copy()
     out[:-1, 1], out[1:, 0] = chosen[:, 0], chosen[:, 1]
+    # the end keys' outer handles (unused: the curve holds beyond the keys) follow the inner
+    # ones, not a finite difference that may be 80,000 degrees out (framing takes handles)
+    out[0, 0], out[-1, 1] = out[0, 1], out[-1, 0]
     return out
 
 

@@ -39,6 +39,16 @@ def test_a_slerp_track_through_gimbal_lock_converts_onto_its_path(y):
     assert handle_reach(curves) < 100
 
 
+def test_end_keys_at_gimbal_lock_keep_their_outer_handles_near():
+    # the outer handles of the end keys play no part (the curve holds beyond the keys) but
+    # are drawn and framed (F frames the selected keys and their handles): they were
+    # 82,000 degrees out, the finite difference at a key 0.01 degrees from gimbal lock
+    times = np.arange(5) * 0.25
+    e = np.array([[10, 89.99, 5], [20, 45, 10], [30, 60, 20], [20, 45, 40], [0, 89.999, 0]])
+    curves = curves_from_track(Track("rotation", times, euler_to_quat(e), "slerp"))
+    assert handle_reach(curves) < 100
+
+
 @pytest.mark.parametrize("order", EULER_ORDERS)
 @pytest.mark.parametrize("mode", ["slerp", "nlerp", "catmull_rom"])
 def test_wandering_near_gimbal_lock_in_every_order(order, mode):
