@@ -11,6 +11,7 @@ from __future__ import annotations
 import hashlib
 import math
 import os
+import unicodedata
 from collections import Counter
 from pathlib import Path
 
@@ -175,13 +176,16 @@ def _unique_bases(job, pairs, settings):
     pairs share (``a/walk.bvh`` and ``b/walk.bvh``; two targets ``x/hero.glb`` and
     ``y/hero.glb``), whose output would be one of the batch's own files (:data:`RESERVED`)
     or that is too long for a file name gets a short hash of the input's path (and the
-    target's), so no task overwrites another's output or the manifest."""
+    target's), so no task overwrites another's output or the manifest. Names are compared
+    as a file system that ignores case and Unicode normalization would (``Walk.bvh`` and
+    ``walk.bvh`` are one file on macOS, Windows and many NAS shares)."""
     bases = [Path(str(s)).stem + (f"__{Path(str(t)).stem}" if t else "") for s, t in pairs]
-    seen = Counter(bases)
+    seen = Counter(map(_fold, bases))
 
     def clash(base):
-        return (seen[base] > 1 or len(name_bytes(base)) > MAX_BASE_BYTES
-                or any(Path(o).parts[0] in RESERVED for o in _outputs(job, base, settings)))
+        return (seen[_fold(base)] > 1 or len(name_bytes(base)) > MAX_BASE_BYTES
+                or any(_fold(Path(o).parts[0]) in RESERVED
+                       for o in _outputs(job, base, settings)))
 
     def tag(source, target, digits):
         key = str(source) + (f"\0{target}" if target else "")
@@ -190,9 +194,14 @@ def _unique_bases(job, pairs, settings):
     out = [f"{_short(b)}-{tag(s, t, 6)}" if clash(b) else b for b, (s, t) in zip(bases, pairs)]
     # 6 hex digits are 24 bits: 20,000 files named take.bvh gave 10 pairs one output name
     # (or a name may be another input's literally); those get the whole hash
-    again = Counter(out)
-    return [f"{_short(b)}-{tag(s, t, 40)}" if again[o] > 1 else o
+    again = Counter(map(_fold, out))
+    return [f"{_short(b)}-{tag(s, t, 40)}" if again[_fold(o)] > 1 else o
             for o, b, (s, t) in zip(out, bases, pairs)]
+
+
+def _fold(name):
+    """``name`` as a case-insensitive, normalizing file system sees it."""
+    return unicodedata.normalize("NFC", name).casefold()
 
 
 def plan(job, sources, outdir, settings):

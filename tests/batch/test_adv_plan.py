@@ -74,15 +74,21 @@ def test_an_output_over_an_input_is_refused_before_any_work(tmp_path):
 def test_many_inputs_of_one_name_never_share_an_output(tmp_path):
     # the 6-digit tag is 24 bits: 20,000 folders each with a take.bvh gave 10 pairs of tasks
     # one output name, each pair's second overwriting the first's
+    import hashlib
     import time
+    from collections import Counter
 
-    srcs = [tmp_path / f"d{i:05d}" / "take.bvh" for i in range(20000)]
+    # fixed paths (nothing is read): the same 10 pairs every time
+    srcs = [Path(f"/library/d{i:05d}/take.bvh") for i in range(20000)]
     t0 = time.perf_counter()
-    tasks = plan("convert", srcs, tmp_path / "out", check_options("convert", {"to": "glb"}))
+    tasks = plan("convert", srcs, Path("/library-out"), check_options("convert", {"to": "glb"}))
     took = time.perf_counter() - t0
     outs = _outputs(tasks)
     assert len(set(outs)) == len(outs) == 20000
-    assert sum(len(o) > len("take-123456.glb") for o in outs) >= 2 * 10   # the lengthened
+    short = Counter(hashlib.sha1(str(s).encode()).hexdigest()[:6] for s in srcs)
+    agree = sum(n for n in short.values() if n > 1)
+    assert agree >= 2   # the case happens here
+    assert sum(len(o) > len("take-123456.glb") for o in outs) == agree   # those lengthened
     assert len({t["id"] for t in tasks}) == 20000
     assert took < 30   # no quadratic step (about 1 s here)
 
@@ -99,3 +105,16 @@ def test_two_task_ids_that_agree_get_longer_digests(tmp_path, monkeypatch):
                check_options("noop", {}))
     ids = [t["id"] for t in got]
     assert len(set(ids)) == 2 and all(len(i.rsplit("-", 1)[1]) == 40 for i in ids)
+
+
+def test_names_one_file_on_a_case_insensitive_share_get_their_own_outputs(tmp_path):
+    # Walk.bvh and walk.bvh (or é composed and decomposed) wrote Walk.glb and walk.glb:
+    # one file on macOS, Windows or an SMB share, where the second overwrote the first
+    import unicodedata
+
+    srcs = [tmp_path / n for n in ("Walk.bvh", "walk.bvh", "caf\u00e9.bvh", "cafe\u0301.bvh",
+                                   "Manifest.glb", "run.bvh")]
+    tasks = plan("convert", srcs, tmp_path / "out", check_options("convert", {"to": "folder"}))
+    outs = [unicodedata.normalize("NFC", o).casefold() for o in _outputs(tasks)]
+    assert len(set(outs)) == len(outs) and "manifest" not in outs
+    assert _outputs(tasks)[-1] == "run"
