@@ -66,10 +66,17 @@ def _walk(folder, skip=None):
     """``os.walk`` of ``folder`` that follows symlinked sub-folders (a library often links
     its parts in) but enters each real folder once, so a symlink loop (``a -> .``) ends;
     hidden entries and the folder ``skip`` (OUTDIR: a batch's own outputs are no inputs)
-    are left out. Yields ``(here, dirs, files)``; a caller may prune ``dirs`` in place."""
+    are left out. Yields ``(here, dirs, files)``; a caller may prune ``dirs`` in place.
+
+    Raises
+    ------
+    BatchUsageError
+        A folder that cannot be listed (``os.walk`` passes over it in silence: a batch
+        would miss its files and say nothing).
+    """
     seen = set()
     skip = None if skip is None else _identity(skip)
-    for root, dirs, files in os.walk(folder, followlinks=True):
+    for root, dirs, files in os.walk(folder, followlinks=True, onerror=_unreadable):
         me = _identity(root)
         if me in seen or (skip is not None and me == skip):
             dirs[:] = []
@@ -77,6 +84,11 @@ def _walk(folder, skip=None):
         seen.add(me)
         dirs[:] = sorted(d for d in dirs if not d.startswith("."))
         yield Path(root), dirs, [f for f in files if not f.startswith(".")]
+
+
+def _unreadable(exc):
+    raise BatchUsageError(f"{exc.filename}: cannot read this folder "
+                          f"({exc.strerror or exc}); its files would be left out")
 
 
 def _identity(path):

@@ -81,3 +81,21 @@ def test_a_folder_named_like_a_file_and_empty_files(tmp_path):
     assert expand_inputs("retarget", [tmp_path / "lib", f"{tmp_path}/lib/*.bvh"]) == [empty]
     with pytest.raises(BatchUsageError, match="no retarget input in this folder"):
         expand_inputs("retarget", [tmp_path / "lib" / "x.bvh"])
+
+
+def test_a_sub_folder_that_cannot_be_read_is_said_not_skipped(tmp_path, monkeypatch):
+    # os.walk passed over it in silence: the batch ran without its files
+    _touch(tmp_path / "lib" / "a.bvh")
+    _touch(tmp_path / "lib" / "locked" / "b.bvh")
+    real = os.scandir
+
+    def scandir(path="."):
+        if str(path).endswith("locked"):
+            raise PermissionError(13, "Permission denied", str(path))
+        return real(path)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    for given in (tmp_path / "lib", f"{tmp_path}/lib/**/*.bvh"):
+        with pytest.raises(BatchUsageError, match="locked: cannot read this folder "
+                                                  r"\(Permission denied\)"):
+            expand_inputs("retarget", [given])
