@@ -143,7 +143,8 @@ def _outputs(job, base, settings):
         return [base + _FORMATS[settings["format"]]]
     if job == "render":
         # a clip's name may hold a slash ("Take 001/run"): no sub-folder of OUTDIR
-        name = f"{base}_{_short(settings['clip'].replace('/', '_').replace(chr(0), '_'))}"
+        clip = settings["clip"].replace("/", "_").replace(chr(0), "_")
+        name = f"{base}_{_short(clip, MAX_CLIP_BYTES)}"
         return [f"{name}.{settings['video']}", f"{name}_sheet.png"]
     if job == "convert":
         return [base + _FORMATS[settings["to"]]]
@@ -164,11 +165,18 @@ RESERVED = {MANIFEST_DIR, THUMBS_DIR, "manifest.json", "report.html"}
 #: Longest output base in UTF-8 bytes: a file name has 255, and the writers' temporary
 #: names (``.NAME.pid123-abcdefgh.tmp``) add about 30.
 MAX_BASE_BYTES = 160
+#: Longest clip name in a render's output names (``BASE_CLIP_sheet.png``), in bytes.
+MAX_CLIP_BYTES = 40
 
 
-def _short(base):
-    """``base`` cut to :data:`MAX_BASE_BYTES` bytes at a character's boundary."""
-    return name_bytes(base)[:MAX_BASE_BYTES].decode(errors="ignore")
+def _short(text, limit=MAX_BASE_BYTES):
+    """``text`` cut to ``limit`` bytes at a character's boundary."""
+    return name_bytes(text)[:limit].decode(errors="ignore")
+
+
+def _tagged(base, digest):
+    """``BASE-DIGEST``, ``base`` cut so that the whole stays within :data:`MAX_BASE_BYTES`."""
+    return f"{_short(base, MAX_BASE_BYTES - 1 - len(digest))}-{digest}"
 
 
 def _unique_bases(job, pairs, settings):
@@ -191,11 +199,11 @@ def _unique_bases(job, pairs, settings):
         key = str(source) + (f"\0{target}" if target else "")
         return hashlib.sha1(name_bytes(key)).hexdigest()[:digits]
 
-    out = [f"{_short(b)}-{tag(s, t, 6)}" if clash(b) else b for b, (s, t) in zip(bases, pairs)]
+    out = [_tagged(b, tag(s, t, 6)) if clash(b) else b for b, (s, t) in zip(bases, pairs)]
     # 6 hex digits are 24 bits: 20,000 files named take.bvh gave 10 pairs one output name
     # (or a name may be another input's literally); those get the whole hash
     again = Counter(map(_fold, out))
-    return [f"{_short(b)}-{tag(s, t, 40)}" if again[_fold(o)] > 1 else o
+    return [_tagged(b, tag(s, t, 40)) if again[_fold(o)] > 1 else o
             for o, b, (s, t) in zip(out, bases, pairs)]
 
 

@@ -118,3 +118,19 @@ def test_names_one_file_on_a_case_insensitive_share_get_their_own_outputs(tmp_pa
     outs = [unicodedata.normalize("NFC", o).casefold() for o in _outputs(tasks)]
     assert len(set(outs)) == len(outs) and "manifest" not in outs
     assert _outputs(tasks)[-1] == "run"
+
+
+def test_every_output_name_and_its_temporary_fit_a_file_name(tmp_path):
+    # a render's clip name came on top of a 160-byte base, and the whole 40-digit tag on
+    # top of a cut one: names over 255 bytes, whose writes fail
+    long_a = tmp_path / "a" / ("é" * 150 + ".glb")
+    long_b = tmp_path / "b" / ("é" * 150 + ".glb")
+    for job, options in (("render", {"clip": "x" * 300}), ("convert", {"to": "glb"})):
+        tasks = plan(job, [long_a, long_b], tmp_path / "out", check_options(job, options))
+        for name in _outputs(tasks):
+            assert len(f".{name}.pid4194304-abcdefgh.tmp".encode()) <= 255, name
+    # the whole tag too (forced: two tasks whose short tags agree)
+    from rigedit.batch import tasks as tasks_module
+
+    assert len(tasks_module._tagged("é" * 150, "f" * 40).encode()) <= \
+        tasks_module.MAX_BASE_BYTES
