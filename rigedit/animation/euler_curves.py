@@ -89,6 +89,41 @@ def _pick(a, b, ref):
     return np.where(closer[..., None], a, b)
 
 
+#: Degrees within which a middle angle of +-90 is gimbal lock (scipy gives 90 or 89.99...).
+LOCK_TOLERANCE = 1e-6
+
+
+def _lock_slide(seq, axes):
+    """(N,) +1 or -1 for rows at gimbal lock (the middle angle at +-90 degrees: the first
+    and last axes coincide, and ``(a + d, b, c + s d)`` is the same rotation for every d
+    with this s), 0 elsewhere. ``seq``: (N, 3) angles in the order's sequence."""
+    locked = np.abs(np.abs(seq[:, 1]) - 90.0) < LOCK_TOLERANCE
+    out = np.zeros(len(seq))
+    if locked.any():
+        order = "".join("XYZ"[a] for a in axes)
+        rows = seq[locked]
+        xyz = np.empty_like(rows)
+        xyz[:, axes] = rows
+        moved = xyz.copy()
+        moved[:, axes[0]] += 10.0
+        moved[:, axes[2]] += 10.0
+        dot = np.abs(np.sum(euler_to_quat(xyz, order) * euler_to_quat(moved, order), axis=1))
+        out[locked] = np.where(dot > 1 - 1e-9, 1.0, -1.0)
+    return out
+
+
+def _slide(row, slide, ref):
+    """A gimbal-locked ``row`` (3 floats, the order's sequence) slid along its family to the
+    triple nearest ``ref`` (least squares on the first and last angle), whole turns added."""
+    a, b, c = row
+    # the family keeps c - s a (up to whole turns): take its turn nearest the reference's,
+    # then the point of that line nearest the reference
+    keep = c - slide * a
+    keep += 360.0 * round(((ref[2] - slide * ref[0]) - keep) / 360.0)
+    first = (ref[0] + slide * (ref[2] - keep)) / 2.0
+    return [first, b + 360.0 * round((ref[1] - b) / 360.0), keep + slide * first]
+
+
 def nearest(angles, order, references):
     """Each row of Euler angles as the equivalent triple nearest its own reference row.
 
@@ -104,8 +139,13 @@ def nearest(angles, order, references):
     """
     axes = _check(order)
     seq, alt = _triples(angles, axes)
+    ref = np.asarray(references, dtype=float)[:, axes]
+    picked = _pick(seq, alt, ref)
+    slide = _lock_slide(seq, axes)
+    for i in np.flatnonzero(slide):   # gimbal lock: a continuum of triples, not two
+        picked[i] = _slide(seq[i].tolist(), slide[i], ref[i].tolist())
     out = np.empty_like(seq)
-    out[:, axes] = _pick(seq, alt, np.asarray(references, dtype=float)[:, axes])
+    out[:, axes] = picked
     return out
 
 
@@ -137,22 +177,30 @@ def unwrap(angles, order=DEFAULT_ORDER, reference=None):
     # fast path: whole turns per axis on one branch (np.unwrap). When no step between rows
     # is 90 degrees or more, the other branch (180 away on two angles) is never nearer, so
     # this is what the key-by-key choice gives; else (through gimbal lock) key by key.
+    slide = _lock_slide(seq, axes)
     fast = np.unwrap(base, period=360.0, axis=0)
-    if len(fast) < 2 or np.max(np.abs(np.diff(fast, axis=0))) < 90.0:
+    if not slide.any() and (len(fast) < 2 or np.max(np.abs(np.diff(fast, axis=0))) < 90.0):
         res = np.empty_like(fast)
         res[:, axes] = fast
         return res
-    return _unwrap_sequential(seq, alt, axes, reference)
+    return _unwrap_sequential(seq, alt, axes, reference, slide)
 
 
-def _unwrap_sequential(seq, alt, axes, reference):
-    """:func:`unwrap` key by key: each row the triple nearest the row before."""
+def _unwrap_sequential(seq, alt, axes, reference, slide=None):
+    """:func:`unwrap` key by key: each row the triple nearest the row before; a row at
+    gimbal lock (``slide`` nonzero, see :func:`_lock_slide`) slid along its continuum of
+    triples, to the row before, then to the middle of its two neighbours (the neighbours'
+    own triples are unique: a key keyed (30, 90, 30) between (20, 75, 20) and (40, 75, 40)
+    reads so, not (0, 90, 0), scipy's pick, a dip in two curves)."""
     prev = None if reference is None else [float(x) for x in np.asarray(reference)[axes]]
     rows = []
+    slides = (_lock_slide(seq, axes) if slide is None else slide).tolist()
     # sequential (each key depends on the one before), so on Python floats: numpy's per-call
     # overhead would make it ~30 times slower per key
-    for a, b in zip(seq.tolist(), alt.tolist()):
-        if prev is not None:
+    for a, b, s in zip(seq.tolist(), alt.tolist(), slides):
+        if prev is not None and s:
+            a = _slide(a, s, prev)
+        elif prev is not None:
             a = [x + 360.0 * round((p - x) / 360.0) for x, p in zip(a, prev)]
             b = [x + 360.0 * round((p - x) / 360.0) for x, p in zip(b, prev)]
             if sum((x - p) ** 2 for x, p in zip(b, prev)) < \
@@ -160,6 +208,12 @@ def _unwrap_sequential(seq, alt, axes, reference):
                 a = b
         rows.append(a)
         prev = a
+    for i, s in enumerate(slides):
+        if s and 0 < i < len(rows) - 1 and not slides[i + 1]:
+            mid = [(p + n) / 2.0 for p, n in zip(rows[i - 1], rows[i + 1])]
+            rows[i] = _slide(rows[i], s, mid)
+        elif s and i == 0 and reference is None and len(rows) > 1 and not slides[1]:
+            rows[0] = _slide(rows[0], s, rows[1])    # the first key: near the second
     out = np.array(rows, dtype=np.float64).reshape(-1, 3)
     res = np.empty_like(out)
     res[:, axes] = out
