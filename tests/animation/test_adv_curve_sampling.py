@@ -82,3 +82,19 @@ def test_any_handles_keep_a_function_of_time_without_nan(gaps, reach, numbers, s
     tol = 1e-9 * np.maximum(1.0, np.abs(y).max(axis=1))
     assert np.all((s >= y.min(axis=1) - tol) & (s <= y.max(axis=1) + tol))   # inside its hull
     np.testing.assert_allclose(c.sample(t), v, rtol=0, atol=1e-9 * max(1.0, np.abs(v).max()))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.floats(-9, 2), min_size=1, max_size=7),       # log10 of the key gaps
+       st.lists(st.floats(-6, 3), min_size=8, max_size=8),       # log10 of the value steps
+       st.lists(st.booleans(), min_size=8, max_size=8))
+def test_auto_clamped_never_overshoots_on_any_spacing(gaps, steps, down):
+    # monotonic runs and turns, keys a nanosecond to 100 s apart, steps of 1e-6 to 1000
+    t = np.r_[0.0, np.cumsum(10.0 ** np.array(gaps))]
+    v = np.cumsum(np.where(down[:len(t)], -1.0, 1.0) * 10.0 ** np.array(steps[:len(t)]))
+    c = Curve(t, v)
+    for k in range(len(t) - 1):
+        s = c.sample(np.linspace(t[k], t[k + 1], 41))
+        lo, hi = sorted(v[k:k + 2])
+        slack = 1e-12 * max(1.0, np.abs(v).max())
+        assert s.min() >= lo - slack and s.max() <= hi + slack
