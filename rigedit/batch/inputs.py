@@ -192,6 +192,8 @@ def expand_inputs(job, inputs, outdir=None):
     out = set()
     for text in inputs:
         text = str(text)
+        if not text.strip():   # Path("") is ".": an unset "$DIR" searched the working folder
+            raise BatchUsageError(f"expected an input, got an empty name {text!r}")
         path = Path(text).expanduser()
         if rigs and text in BUNDLED and not path.exists():
             out.add(Path(text))

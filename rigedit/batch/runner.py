@@ -57,7 +57,11 @@ class Summary:
 
 def outdir_path(out):
     """OUTDIR as an absolute path; ``BatchUsageError`` when it is a file or its parent is
-    missing (nothing is made yet)."""
+    missing (nothing is made yet), or it is an empty name (``-o "$OUT"`` with OUT unset would
+    write into the working folder)."""
+    if not str(out).strip():
+        raise BatchUsageError(f"-o: expected a folder for the outputs, got an empty name "
+                              f"{str(out)!r}")
     out = Path(out).expanduser().absolute()
     if out.exists() and not out.is_dir():
         raise BatchUsageError(f"{out}: expected a folder for the outputs, got a file")

@@ -99,3 +99,12 @@ def test_a_sub_folder_that_cannot_be_read_is_said_not_skipped(tmp_path, monkeypa
         with pytest.raises(BatchUsageError, match="locked: cannot read this folder "
                                                   r"\(Permission denied\)"):
             expand_inputs("retarget", [given])
+
+
+@pytest.mark.parametrize("empty", ["", " "])
+def test_an_empty_input_name_is_refused_not_the_working_folder(tmp_path, monkeypatch, empty):
+    # `rigedit batch convert "$DIR"` with DIR unset searched the working folder
+    _touch(tmp_path / "cwd" / "stray.bvh")
+    monkeypatch.chdir(tmp_path / "cwd")
+    with pytest.raises(BatchUsageError, match="empty name"):
+        expand_inputs("retarget", [empty])

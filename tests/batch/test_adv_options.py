@@ -55,3 +55,11 @@ def test_a_good_joint_map_passes(tmp_path):
     path = tmp_path / "map.json"
     path.write_text('{"Hips": "Hips"}')
     assert check_options("retarget", {"to": ["humanoid"], "map": str(path)})["map"] == str(path)
+
+
+def test_an_empty_outdir_is_refused_not_the_working_folder(tmp_path, monkeypatch, capsys):
+    # -o "$OUT" with OUT unset wrote the outputs, manifest and report into the working folder
+    monkeypatch.chdir(tmp_path)
+    assert main(["batch", "convert", "humanoid", "--to", "glb", "-o", ""]) == 2
+    assert "empty name" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
