@@ -15,6 +15,8 @@ import unicodedata
 from collections import Counter
 from pathlib import Path
 
+from ..io.bundled import BUNDLED
+from ..io.registry import RIG_FILE_SUFFIXES
 from .inputs import BatchUsageError, name_bytes, rig_source
 from .manifest import MANIFEST_DIR, task_id
 
@@ -67,6 +69,22 @@ def _axes(up, forward):
         raise BatchUsageError(f"autorig --up/--forward: {exc}") from None
 
 
+def _target(text):
+    """``retarget --to``: a bundled name, a rig folder or a rig file (a folder of rigs or a
+    ``.txt`` would fail every task alike)."""
+    source = rig_source(text)
+    path = Path(source)
+    if source in BUNDLED and not path.exists():
+        return source
+    if path.is_dir() and not (path / "skeleton.json").is_file():
+        raise BatchUsageError(f"retarget --to {text}: expected a rig (a file or a folder "
+                              f"holding a skeleton.json), got a folder without one")
+    if path.is_file() and path.suffix.lower() not in RIG_FILE_SUFFIXES:
+        raise BatchUsageError(f"retarget --to {text}: expected a rig file "
+                              f"({', '.join(RIG_FILE_SUFFIXES)}), got a {path.suffix or 'file'}")
+    return source
+
+
 def _joint_map(path):
     """``retarget --map``: a JSON joint map (its names are checked against each task's
     skeletons there); one that is no map would fail every task alike."""
@@ -114,7 +132,7 @@ def check_options(job, options):
         targets = s["to"] if isinstance(s["to"], (list, tuple)) else [s["to"]] * bool(s["to"])
         if not targets:
             raise BatchUsageError("retarget: expected at least one target rig (--to RIG)")
-        s["to"] = sorted({rig_source(t) for t in targets})
+        s["to"] = sorted({_target(t) for t in targets})
         if s["map"] is not None:
             s["map"] = rig_source(s["map"])
             _joint_map(s["map"])

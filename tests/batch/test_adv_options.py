@@ -63,3 +63,17 @@ def test_an_empty_outdir_is_refused_not_the_working_folder(tmp_path, monkeypatch
     assert main(["batch", "convert", "humanoid", "--to", "glb", "-o", ""]) == 2
     assert "empty name" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_target_that_is_no_rig_is_refused_before_any_task(tmp_path):
+    (tmp_path / "chars").mkdir()
+    (tmp_path / "hero.txt").write_text("x")
+    for target, message in ((tmp_path / "chars", "folder without one"),
+                            (tmp_path / "hero.txt", "expected a rig file")):
+        with pytest.raises(BatchUsageError, match=f"retarget --to .*{message}"):
+            check_options("retarget", {"to": [str(target)]})
+    rig = tmp_path / "fox"
+    rig.mkdir()
+    (rig / "skeleton.json").write_text("{}")
+    assert check_options("retarget", {"to": [str(rig), "humanoid"]})["to"] == \
+        sorted([str(rig), "humanoid"])
