@@ -12,6 +12,7 @@ from __future__ import annotations
 import copy
 import datetime
 import functools
+import math
 import os
 import socket
 import time
@@ -240,4 +241,22 @@ def run_task(task):
         entry["thumbnail"] = thumb
     entry["seconds"] = round(time.perf_counter() - t0, 3)
     entry["finished"] = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+    entry["quality"] = _plain(entry["quality"])
     return entry
+
+
+def _plain(value):
+    """``value`` as strict JSON takes it: numpy scalars and arrays as numbers and lists, a
+    NaN or an infinity as None (``manifest.json`` is for tools too: ``jq`` refuses ``NaN``,
+    and ``json.dump`` raised on a ``float32`` in the client, ending the batch)."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if hasattr(value, "tolist") and not isinstance(value, (str, bytes)):   # numpy
+        return _plain(value.tolist())
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if value is None or isinstance(value, (str, int, float)):
+        return value
+    return str(value)

@@ -50,3 +50,26 @@ def test_a_rig_folder_cut_short_is_one_failed_entry(tmp_path):
     (task,) = plan("convert", [rig], tmp_path, check_options("convert", {"to": "glb"}))
     entry = run_task(task)
     assert entry["status"] == "failed" and entry["error"].startswith(str(rig))
+
+
+def test_a_jobs_figures_are_strict_json_whatever_their_types(tmp_path, monkeypatch):
+    # a float32 made json.dump raise in the client (the batch ended); a NaN wrote "NaN",
+    # which jq and JSON.parse refuse
+    import json
+
+    import numpy as np
+    from rigedit.batch import jobs
+    from rigedit.batch.manifest import Manifest
+
+    monkeypatch.setitem(jobs._JOBS, "noop", lambda task: (
+        {"a": np.float32(1.5), "b": float("nan"), "c": np.arange(3), "d": (np.int64(2),),
+         "e": -float("inf"), "f": {"g": np.bool_(True)}}, []))
+    src = tmp_path / "a.bvh"
+    src.write_bytes(b"x")
+    (task,) = plan("noop", [src], tmp_path, check_options("noop", {}))
+    entry = run_task(task)
+    assert entry["status"] == "ok", entry["error"]
+    assert entry["quality"] == {"a": 1.5, "b": None, "c": [0, 1, 2], "d": [2], "e": None,
+                                "f": {"g": True}}
+    json.dumps(entry, allow_nan=False)
+    Manifest(tmp_path).write(entry)
