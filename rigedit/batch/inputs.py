@@ -62,21 +62,26 @@ def _is_rig_folder(path):
     return path.is_dir() and (path / "skeleton.json").is_file()
 
 
-def _walk(folder, skip=None):
+def _walk(folder, skip=None, skipped=None):
     """``os.walk`` of ``folder`` that follows symlinked sub-folders (a library often links
     its parts in) but enters each real folder once, so a symlink loop (``a -> .``) ends;
     hidden entries and the folder ``skip`` (OUTDIR: a batch's own outputs are no inputs)
     are left out. Yields ``(here, dirs, files)``; a caller may prune ``dirs`` in place.
 
-    Raises
-    ------
-    BatchUsageError
-        A folder that cannot be listed (``os.walk`` passes over it in silence: a batch
-        would miss its files and say nothing).
+    A folder that cannot be listed (``os.walk`` passes over it in silence: a batch would
+    miss its files and say nothing) is appended to ``skipped`` as ``(path, reason)``, or
+    without that list raises ``BatchUsageError``.
     """
     seen = set()
     skip = None if skip is None else _identity(skip)
-    for root, dirs, files in os.walk(folder, followlinks=True, onerror=_unreadable):
+
+    def unreadable(exc):
+        if skipped is None:
+            raise BatchUsageError(f"{exc.filename}: cannot read this folder "
+                                  f"({exc.strerror or exc}); its files would be left out")
+        skipped.append((exc.filename, exc.strerror or str(exc)))
+
+    for root, dirs, files in os.walk(folder, followlinks=True, onerror=unreadable):
         me = _identity(root)
         if me in seen or (skip is not None and me == skip):
             dirs[:] = []
@@ -84,11 +89,6 @@ def _walk(folder, skip=None):
         seen.add(me)
         dirs[:] = sorted(d for d in dirs if not d.startswith("."))
         yield Path(root), dirs, [f for f in files if not f.startswith(".")]
-
-
-def _unreadable(exc):
-    raise BatchUsageError(f"{exc.filename}: cannot read this folder "
-                          f"({exc.strerror or exc}); its files would be left out")
 
 
 def _identity(path):
@@ -100,11 +100,11 @@ def _identity(path):
     return st.st_dev, st.st_ino
 
 
-def _search(folder, suffixes, take_rig_folders, skip=None):
+def _search(folder, suffixes, take_rig_folders, skip=None, skipped=None):
     """Files under ``folder`` whose suffix is one of ``suffixes`` (hidden entries, ``skip``
     and rig folders' insides skipped; rig folders themselves when ``take_rig_folders``)."""
     found = []
-    for here, dirs, files in _walk(folder, skip):
+    for here, dirs, files in _walk(folder, skip, skipped):
         keep = []
         for d in dirs:
             if _is_rig_folder(here / d):
@@ -128,7 +128,7 @@ def _match(parts, pattern):
         and _match(parts[1:], pattern[1:])
 
 
-def _glob(text, skip=None):
+def _glob(text, skip=None, skipped=None):
     """The paths ``text`` matches. ``glob``'s own ``**`` follows symlinks without end (two
     links to ``.`` make 2**40 paths), so a recursive pattern walks with :func:`_walk`."""
     text = os.path.expanduser(text)
@@ -138,7 +138,7 @@ def _glob(text, skip=None):
         return
     first = next(i for i, part in enumerate(parts) if glob.has_magic(part))
     root, pattern = Path(*parts[:first]) if first else Path("."), parts[first:]
-    for here, dirs, files in _walk(root, skip):
+    for here, dirs, files in _walk(root, skip, skipped):
         rel = here.relative_to(root).parts if here != root else ()
         for name in dirs + files:
             if _match(rel + (name,), pattern):
@@ -159,7 +159,7 @@ def _inside(path, folder):
     return folder is not None and (path == folder or folder in path.parents)
 
 
-def expand_inputs(job, inputs, outdir=None):
+def expand_inputs(job, inputs, outdir=None, skipped=None):
     """Every path a batch of ``job`` reads from ``inputs``, sorted and without repeats.
 
     Parameters
@@ -174,6 +174,9 @@ def expand_inputs(job, inputs, outdir=None):
     outdir : Path, optional
         The batch's OUTDIR: a folder search or a pattern leaves it out (a second run must
         not take the first one's outputs for inputs); a file named on its own is kept.
+    skipped : list, optional
+        Where a sub-folder that cannot be listed goes, as ``(path, reason)`` (``lost+found``
+        at the top of a volume); without it such a folder is a ``BatchUsageError``.
 
     Returns
     -------
@@ -203,7 +206,7 @@ def expand_inputs(job, inputs, outdir=None):
             if own is not None and _resolve(path) == own:
                 raise BatchUsageError(f"{text}: expected inputs apart from OUTDIR, got OUTDIR "
                                       "itself (its outputs would be the next run's inputs)")
-            found = _search(path, suffixes, rigs, skip=own)
+            found = _search(path, suffixes, rigs, skip=own, skipped=skipped)
             if not found:
                 raise BatchUsageError(f"{text}: no {job} input in this folder (looked for "
                                       f"{', '.join(suffixes)})")
@@ -211,7 +214,7 @@ def expand_inputs(job, inputs, outdir=None):
         elif path.exists():
             out.add(_resolve(path))
         elif glob.has_magic(text):
-            found = [_resolve(p) for p in _glob(text, skip=own)
+            found = [_resolve(p) for p in _glob(text, skip=own, skipped=skipped)
                      if p.is_file() or (rigs and _is_rig_folder(p))]
             found = [p for p in found if not _inside(p, own)]
             if not found:

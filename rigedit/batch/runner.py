@@ -6,6 +6,7 @@ import os
 import shutil
 import sys
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -190,7 +191,11 @@ def run(job, inputs, out, workers=None, scheduler=None, resume=False, quiet=True
     t0 = time.perf_counter()
     settings = check_options(job, job_options)
     outdir = outdir_path(out)
-    sources = expand_inputs(job, inputs, outdir)
+    skipped = []
+    sources = expand_inputs(job, inputs, outdir, skipped)
+    for folder, why in skipped:   # lost+found at the top of a volume, say: said, not fatal
+        warnings.warn(f"{folder}: cannot read this folder ({why}); its files are left out",
+                      stacklevel=2)
     say = (lambda line: None) if quiet else (lambda line: print(f"rigedit: batch: {line}",
                                                                  file=sys.stderr))
     warm = ("rigedit.batch.jobs",) + (("rigedit.render.recorder",) if settings["thumbnails"]

@@ -96,12 +96,14 @@ def cmd_batch(args):
     """Run the batch; 1 when a task failed (saying how many), else 0."""
     from ..batch import run
     from ..batch.inputs import shown
+    from .output import warning_lines
 
     options = {k: v for k, v in vars(args).items() if k not in _NOT_OPTIONS}
     quiet = getattr(args, "quiet", False)
-    summary = run(args.job, args.inputs, args.output, workers=args.workers,
-                  scheduler=args.scheduler, resume=args.resume, quiet=quiet,
-                  timeout=args.timeout, **options)
+    with warning_lines():   # a folder that cannot be read: one line each (none with -q)
+        summary = run(args.job, args.inputs, args.output, workers=args.workers,
+                      scheduler=args.scheduler, resume=args.resume, quiet=quiet,
+                      timeout=args.timeout, **options)
     report = shown(str(summary.report))   # stdout takes no undecodable bytes of a name
     print(f"{summary.tasks} tasks: {summary.ran} run, {summary.skipped} skipped (done before), "
           f"{summary.failed} failed; {summary.seconds:.1f} s; report {report}")

@@ -14,6 +14,18 @@ def _touch(path, text="x"):
     return path
 
 
+def _unlisted(monkeypatch, name):
+    """Folders called ``name`` cannot be listed (as for a user without the right)."""
+    real = os.scandir
+
+    def scandir(path="."):
+        if str(path).endswith(name):
+            raise PermissionError(13, "Permission denied", str(path))
+        return real(path)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+
+
 def test_a_recursive_glob_ends_on_symlink_loops(tmp_path):
     # two links to "." made glob's own ** list 2**40 paths (it never came back)
     sub = tmp_path / "lib" / "sub"
@@ -87,14 +99,7 @@ def test_a_sub_folder_that_cannot_be_read_is_said_not_skipped(tmp_path, monkeypa
     # os.walk passed over it in silence: the batch ran without its files
     _touch(tmp_path / "lib" / "a.bvh")
     _touch(tmp_path / "lib" / "locked" / "b.bvh")
-    real = os.scandir
-
-    def scandir(path="."):
-        if str(path).endswith("locked"):
-            raise PermissionError(13, "Permission denied", str(path))
-        return real(path)
-
-    monkeypatch.setattr(os, "scandir", scandir)
+    _unlisted(monkeypatch, "locked")
     for given in (tmp_path / "lib", f"{tmp_path}/lib/**/*.bvh"):
         with pytest.raises(BatchUsageError, match="locked: cannot read this folder "
                                                   r"\(Permission denied\)"):
@@ -108,3 +113,19 @@ def test_an_empty_input_name_is_refused_not_the_working_folder(tmp_path, monkeyp
     monkeypatch.chdir(tmp_path / "cwd")
     with pytest.raises(BatchUsageError, match="empty name"):
         expand_inputs("retarget", [empty])
+
+
+def test_a_batch_goes_on_past_an_unreadable_folder_and_says_so(tmp_path, monkeypatch):
+    # lost+found at the top of a volume is unreadable to a user: said, not fatal
+    from rigedit.batch.runner import run
+
+    a = _touch(tmp_path / "lib" / "a.bvh")
+    _touch(tmp_path / "lib" / "lost+found" / "b.bvh")
+    _unlisted(monkeypatch, "lost+found")
+    skipped = []
+    assert expand_inputs("retarget", [tmp_path / "lib"], skipped=skipped) == [a]
+    assert skipped == [(str(tmp_path / "lib" / "lost+found"), "Permission denied")]
+    monkeypatch.setattr("rigedit.batch.runner.Engine.start", lambda self, tasks=None: 1 / 0)
+    with pytest.warns(UserWarning, match=r"lost\+found: cannot read this folder"):
+        with pytest.raises(ZeroDivisionError):   # stopped where the cluster would start
+            run("retarget", [tmp_path / "lib"], tmp_path / "out", to=["humanoid"])
