@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..editor.graph_commands import moved_keys
 from ..editor.playback import snap_to_frame
 
 __all__ = ["Pan", "Scrub", "Box", "KeyDrag", "HandleDrag", "Scale", "selected_curves",
@@ -68,7 +69,9 @@ class KeyDrag:
             t_new = snap_to_frame(t_new, interaction.fps())
         dt = t_new - t_key
         dv = float(tr.v_of(pos.y()) - tr.v_of(self.start.y()))
-        return {cid: cv.with_keys_moved(idx, dt, dv) for cid, (cv, idx) in self.base.items()}
+        # one time offset for every channel, clamped to all of them: keys of one time stay
+        # one key in the timeline when one channel has a neighbour in the way
+        return moved_keys(self.base, dt, dv)
 
 
 class HandleDrag:

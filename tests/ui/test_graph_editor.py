@@ -456,3 +456,29 @@ def test_a_handle_hidden_under_its_key_leaves_the_click_to_the_key(window):
     start = _key_pos(view, T_Y, 1)
     _drag(view, start, start + QtCore.QPoint(0, -30))
     assert d.undo_stack.undo_label == "Move keys"
+
+
+T_X = ChannelId(JOINT, "translation", 0)
+
+
+def test_keys_of_one_time_on_two_channels_move_together_when_one_is_blocked(window):
+    view = _only(window, T_X, T_Y)
+    px = view.transform.px_per_s
+    # T_X's key at 0.6 moved to about 0.4 (Ctrl: off the frames): a neighbour in the way
+    k2 = _key_pos(view, T_X, 2)
+    _drag(view, k2, k2 - QtCore.QPoint(int(round(0.2 * px)), 0),
+          modifiers=QtCore.Qt.ControlModifier)
+    blocker = float(_channel(view, T_X).curve.times[2])
+    assert 0.35 < blocker < 0.45
+    assert _channel(view, T_Y).curve.times[2] == pytest.approx(0.6)
+    # both channels' keys at 0.3 selected, dragged past the blocker
+    QTest.mouseClick(view, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, _key_pos(view, T_Y, 1))
+    QTest.mouseClick(view, QtCore.Qt.LeftButton, QtCore.Qt.ShiftModifier,
+                     _key_pos(view, T_X, 1))
+    assert {k: v.tolist() for k, v in view.selected.items()} == {T_X: [1], T_Y: [1]}
+    start = _key_pos(view, T_Y, 1)
+    _drag(view, start, start + QtCore.QPoint(int(round(0.25 * px)), 0))
+    tx, ty = (float(_channel(view, c).curve.times[1]) for c in (T_X, T_Y))
+    # one offset for both, stopped short of the blocker: still one key time in the timeline
+    assert tx == pytest.approx(ty, abs=1e-12)
+    assert 0.3 < tx < blocker
