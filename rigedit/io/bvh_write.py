@@ -41,10 +41,15 @@ DEFAULT_FPS = 30.0
 _AXES = "XYZ"
 
 
+#: Frames a second above which keys on one grid are not taken for the clip's rate.
+MAX_KEY_RATE = 1000.0
+
+
 def bvh_frame_times(clip, fps=None):
     """Sample times for writing ``clip``: its key rate when every key lies on one regular grid
-    of step ``dt`` from time 0 (divided down to 30 fps or finer when the clip has bezier
-    tracks, whose curves bend between keys), else ``fps`` (default 30) frames per second.
+    of step ``dt`` from time 0 and that rate is at most :data:`MAX_KEY_RATE` (divided down to
+    30 fps or finer when the clip has bezier tracks, whose curves bend between keys), else
+    ``fps`` (default 30) frames per second.
 
     Returns
     -------
@@ -60,7 +65,9 @@ def bvh_frame_times(clip, fps=None):
         if len(keys) >= 2:
             step = float(np.min(np.diff(keys)))
             grid = keys / step
-            if step > 1e-6 and np.allclose(grid, np.round(grid), atol=1e-4):
+            # a grid finer than MAX_KEY_RATE is two keys nudged together (a graph drag
+            # stopped at its neighbour), not a capture rate: 10,000 frames a second of BVH
+            if step >= 1.0 / MAX_KEY_RATE and np.allclose(grid, np.round(grid), atol=1e-4):
                 dt = step
                 if any(tr.curves is not None for tr in clip.tracks.values()):
                     # bezier curves bend between keys: the grid divided to 30 fps or finer

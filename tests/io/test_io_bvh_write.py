@@ -207,3 +207,18 @@ def test_writing_a_figure_that_is_not_human_sized_warns(tmp_path):
     with pytest.warns(UserWarning, match="not a human's 1.2-2.2 m: read it back with "
                                          "scale=0.01"):
         save_bvh(giant, tmp_path / "giant.bvh")
+
+
+def test_keys_nudged_together_are_not_taken_for_a_capture_rate():
+    # keys at 30 fps frames and one stopped 1e-4 s from its neighbour (a graph drag): every
+    # key on a 1e-4 s grid, which is no frame rate (2 s would be 20,001 BVH frames)
+    sk = Skeleton(["a", "b"], [-1, 0], [[0, 0, 0], [0, 1, 0]])
+    t = np.array([0.0, 0.3, 0.2999, 1.0, 2.0])
+    q = np.tile([0.0, 0.0, 0.0, 1.0], (5, 1))
+    clip = Clip("take", sk, {("b", "rotation"): Track("rotation", t, q)}, duration=2.0)
+    times, dt = bvh_frame_times(clip)
+    assert dt == pytest.approx(1 / 30) and len(times) == 61
+    # a real 120 Hz capture keeps its rate
+    t120 = np.arange(241) / 120.0
+    clip = Clip("take", sk, {("b", "rotation"): Track("rotation", t120, np.tile(q[:1], (241, 1)))})
+    assert bvh_frame_times(clip)[1] == pytest.approx(1 / 120)
