@@ -115,9 +115,18 @@ def cmd_autorig(args):
     return run_autorig(args)
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """argparse's parser with its errors on one line (its own print the usage first: five
+    lines for ``rigedit compress``) naming where the usage is; exit 2 as argparse does.
+    Subcommand parsers are of the same class (argparse makes them so)."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser():
     """The ``rigedit`` parser: one subcommand per job, each added by its ``_add_*``."""
-    p = argparse.ArgumentParser(prog="rigedit", description="Rig editor for 3D characters: "
+    p = OneLineParser(prog="rigedit", description="Rig editor for 3D characters: "
                                 "headless jobs. RIG is a rig folder, a .glb/.gltf/.fbx/.bvh "
                                 "file or a bundled name (quadruped, the default, or humanoid).")
     sub = p.add_subparsers(dest="command", required=True)
