@@ -59,6 +59,11 @@ def check_compression(args, output):
     ``args.shell_m`` (metres)."""
     args.max_error_m = _centimetres("max-error", args.max_error, DEFAULT_MAX_ERROR_CM) / 100
     args.shell_m = _centimetres("shell", args.shell, DEFAULT_SHELL_CM) / 100
+    for name, metres, cm in (("max-error", args.max_error_m, args.max_error),
+                             ("shell", args.shell_m, args.shell)):
+        if metres <= 0:   # 5e-324 cm is positive; in metres it is 0
+            raise UsageError(f"--{name}: expected a positive number of centimetres up to "
+                             f"{LARGEST_CM:g}, got {cm:g} (0 in metres)")
     if args.meshopt:
         if Path(output).suffix.lower() not in GLTF_SUFFIXES:
             raise UsageError(f"--meshopt: expected a .glb or .gltf OUT, got {output}")
@@ -103,8 +108,13 @@ def compress_and_write(rig, names, output, args):
     from ..compression import compress_clips
     from ..io.compressed_file import SUFFIX, save_compressed
 
-    result = compress_clips(rig.skeleton, {n: rig.clips[n] for n in names}, target="rigedit",
-                            **bound)
+    from ..errors import RigFileError
+
+    try:
+        result = compress_clips(rig.skeleton, {n: rig.clips[n] for n in names},
+                                target="rigedit", **bound)
+    except ValueError as exc:   # a bound no encoding reaches: named like the glTF output's
+        raise RigFileError(output, str(exc)) from None
     if Path(output).suffix.lower() == SUFFIX:
         save_compressed(output, rig.skeleton, result.clips)
     else:

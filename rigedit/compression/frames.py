@@ -79,8 +79,9 @@ def frame_times(clip, rate=None):
         gap = np.minimum(np.abs(keys[near] - grid), np.abs(keys[near - 1] - grid)) \
             if len(keys) > 1 else np.abs(keys[0] - grid)
         grid = grid[gap > 0.01 / rate]
-    times = np.union1d(grid, keys)
-    return times[np.r_[True, np.diff(times) > KEY_TOLERANCE]] if len(times) > 1 else times
+    # every distinct key time stays a frame, however close to the one before: two keys 1e-7 s
+    # apart are a jump the source plays (the grid times near a key were dropped above)
+    return np.union1d(grid, keys)
 
 
 def local_times(duration, loop, times):

@@ -5,10 +5,11 @@ A clip is one blob, little-endian; ``varint`` is LEB128 (7 bits a byte, low firs
 ====================  ======================================================================
 name                  varint n, n bytes UTF-8
 duration              float64 seconds (a looping clip wraps at it: exactly the source's)
-flags                 uint8: bit 0 loop, bit 1 uniform frame times
+flags                 uint8: bit 0 loop, bit 1 uniform frame times, bit 2 float64 times
 frames                varint F (frame count of the time grid, >= 1)
 time grid             uniform: float64 start, float64 period (frame i at start + i period);
-                      else F float32 times
+                      else F float32 times (bit 2: F float64 times, for frames float32
+                      cannot keep apart)
 constant tracks       varint C, then C x (varint joint, uint8 channel, 3 or 4 float32)
 animated tracks       varint A, then A track headers:
                       varint joint; uint8 channel (bits 0-1: 0 translation, 1 rotation,
@@ -39,6 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..animation.clip_names import check_clip_name
 from .bits import MAX_FIELD_BITS, pack
 from .quantise import (PER_KEY, SEGMENT, SEGMENT_HEADER_BITS, VectorCode, unit_range_codes,
                        unit_range_values)
@@ -83,14 +85,22 @@ class ClipLayout:
     uniform: tuple             # (start, period) or None
     constant: list             # EncodedTrack
     animated: list             # EncodedTrack
+    wide: bool = False         # non-uniform times stored as float64 (float32 merges some)
 
 
-def grid_times(count, uniform, times=None):
-    """The decoded frame times (F,) float64 of a grid."""
+#: Flag bit of a clip whose non-uniform frame times are stored as float64.
+WIDE_TIMES = 4
+#: Largest frame time or duration a blob may hold, seconds (about 30 years): far beyond any
+#: clip, and small enough that a pose's time arithmetic stays finite and exact to the key.
+MAX_SECONDS = 1e9
+
+
+def grid_times(count, uniform, times=None, wide=False):
+    """The decoded frame times (F,) float64 of a grid (``wide``: float64 times, else float32)."""
     if uniform is not None:
         start, period = uniform
         return start + np.arange(count) * period
-    return np.asarray(times, dtype=np.float32).astype(np.float64)
+    return np.asarray(times, dtype=np.float64 if wide else np.float32).astype(np.float64)
 
 
 def varint(n):
@@ -133,12 +143,14 @@ def write_clip(layout):
     out = bytearray()
     name = layout.name.encode("utf-8")
     out += varint(len(name)) + name
-    out += struct.pack("<dB", layout.duration, int(layout.loop) | (2 if layout.uniform else 0))
+    wide = bool(layout.wide) and not layout.uniform
+    out += struct.pack("<dB", layout.duration, int(layout.loop) | (2 if layout.uniform else 0)
+                       | (WIDE_TIMES if wide else 0))
     out += varint(len(layout.times))
     if layout.uniform:
         out += struct.pack("<dd", *layout.uniform)
     else:
-        out += np.asarray(layout.times, dtype="<f4").tobytes()
+        out += np.asarray(layout.times, dtype="<f8" if wide else "<f4").tobytes()
     out += varint(len(layout.constant))
     for tr in layout.constant:
         out += varint(tr.joint) + bytes([CHANNEL_CODES[tr.channel]])
@@ -230,7 +242,8 @@ class ByteReader:
 
     def floats(self, n, what, dtype="<f4"):
         size = np.dtype(dtype).itemsize
-        return np.frombuffer(self.take(n * size, what), dtype=dtype).astype(np.float64)
+        with np.errstate(invalid="ignore", over="ignore"):   # a NaN is refused by the caller
+            return np.frombuffer(self.take(n * size, what), dtype=dtype).astype(np.float64)
 
 
 def read_clip(blob, num_joints):
@@ -253,23 +266,33 @@ def read_clip(blob, num_joints):
     """
     r = ByteReader(blob)
     size = len(blob)
-    name = bytes(r.take(r.varint("clip name length", size), "clip name")).decode(
-        "utf-8", errors="replace")
+    raw = bytes(r.take(r.varint("clip name length", size), "clip name"))
+    try:   # not UTF-8, or a name a Clip would refuse (a control character, a slash)
+        name = check_clip_name(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise LayoutError(f"clip name {raw[:40]!r}: expected UTF-8") from None
+    except ValueError as exc:
+        raise LayoutError(str(exc)) from None
     duration, flags = struct.unpack("<dB", r.take(9, "duration and flags"))
-    if not np.isfinite(duration) or duration < 0:
-        raise LayoutError(f"clip {name!r}: duration {duration}, expected a finite number >= 0")
+    if not 0 <= duration <= MAX_SECONDS:   # also refuses NaN
+        raise LayoutError(f"clip {name!r}: duration {duration}, expected 0 to {MAX_SECONDS:g} "
+                          "seconds")
     count = r.varint("frame count", size * 8)
     if count < 1:
         raise LayoutError(f"clip {name!r}: no frames")
     if flags & 2:
         start, period = struct.unpack("<dd", r.take(16, "frame grid"))
-        if not (np.isfinite(start) and np.isfinite(period)) or period < 0:
-            raise LayoutError(f"clip {name!r}: frame grid {start}, {period} not finite")
+        end = start + (count - 1) * period if abs(period) <= MAX_SECONDS else np.inf
+        if not (abs(start) <= MAX_SECONDS and abs(end) <= MAX_SECONDS and period >= 0):
+            raise LayoutError(f"clip {name!r}: frame grid {start}, {period}: expected times "
+                              f"within {MAX_SECONDS:g} seconds")
         uniform, times = (start, period), grid_times(count, (start, period))
     else:
-        uniform, times = None, r.floats(count, "frame times")
-        if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
-            raise LayoutError(f"clip {name!r}: frame times not finite and increasing")
+        wide = bool(flags & WIDE_TIMES)
+        uniform, times = None, r.floats(count, "frame times", "<f8" if wide else "<f4")
+    if not np.all(np.abs(times) <= MAX_SECONDS) or np.any(np.diff(times) <= 0):
+        raise LayoutError(f"clip {name!r}: frame times not finite, increasing and within "
+                          f"{MAX_SECONDS:g} seconds")
     constant = []
     for _ in range(r.varint("constant track count", size)):
         joint = r.varint("joint index", num_joints - 1)
@@ -318,7 +341,7 @@ def read_clip(blob, num_joints):
     if r.at != size:
         raise LayoutError(f"clip {name!r}: {size - r.at} bytes after the bit stream")
     layout = ClipLayout(name, float(duration), bool(flags & 1), times, uniform, constant,
-                        animated)
+                        animated, uniform is None and bool(flags & WIDE_TIMES))
     return layout, stream, _key_frames(layout, stream, dbits_all)
 
 

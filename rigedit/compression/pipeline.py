@@ -67,22 +67,45 @@ def check_max_error(max_error):
     return value
 
 
-def _grid(times):
-    """``(uniform, decoded times)``: a uniform grid (start, period) when the frames are evenly
-    spaced to 1e-7 s, else None and the float32 times."""
+def _grid(times, target="rigedit"):
+    """``(uniform, decoded times, wide)`` of a clip's frames (F,): a uniform grid (start,
+    period) when the frames are evenly spaced to 1e-7 s; else the float32 times, or, where
+    float32 would merge two frames (keys 2e-6 s apart at 100 s) or move one by more than 1%
+    of its gap to a neighbour (keys 1e-7 s apart), float64 ones (``wide``) in
+    rigedit's format and, in glTF's (float32 only), float32 times kept strictly increasing
+    (:func:`increasing_float32`), the check then measuring what that costs."""
     f = len(times)
     period = float((times[-1] - times[0]) / (f - 1)) if f > 1 else 0.0
     uniform = (float(times[0]), period)
     grid = grid_times(f, uniform)
     if np.max(np.abs(grid - times)) <= 1e-7:
-        return uniform, grid
-    return None, grid_times(f, None, times)
+        return uniform, grid, False
+    grid = grid_times(f, None, times)
+    gaps = np.diff(times)
+    nearest = np.minimum(np.r_[np.inf, gaps], np.r_[gaps, np.inf])
+    if np.all(np.diff(grid) > 0) and np.all(np.abs(grid - times) <= 0.01 * nearest):
+        return None, grid, False
+    if target == "gltf":
+        return None, increasing_float32(times), False
+    return None, grid_times(f, None, times, wide=True), True
+
+
+def increasing_float32(times):
+    """Times (F,) float64, increasing, rounded to float32 and then kept strictly increasing
+    (a frame float32 cannot tell from the one before it goes one float32 step later), as
+    float64."""
+    t32 = np.asarray(times, dtype=np.float32)
+    merged = np.flatnonzero(np.diff(t32) <= 0)
+    for i in range(merged[0] + 1 if len(merged) else len(t32), len(t32)):
+        if t32[i] <= t32[i - 1]:   # after a nudge the next frame may be merged in turn
+            t32[i] = np.nextafter(t32[i - 1], np.float32(np.inf))
+    return t32.astype(np.float64)
 
 
 def _kinds(layout, size):
     """Compressed bytes per kind of one clip blob (section header included in ``header``)."""
     kinds = dict.fromkeys(("rotation", "translation", "scale", "times", "header"), 0.0)
-    kinds["times"] += 0 if layout.uniform else 4 * len(layout.times)
+    kinds["times"] += 0 if layout.uniform else (8 if layout.wide else 4) * len(layout.times)
     for tr in layout.constant:
         kinds[tr.channel] += 4 * len(tr.value)
     frames = len(layout.times)
@@ -106,7 +129,7 @@ def _compress_one(skeleton, clip, max_error, distances, target, shell, mesh):
     times = frame_times(clip)
     meter = ErrorMeter(skeleton, clip, times, shell, mesh)
     budget = Budget(skeleton, max_error, distances)
-    uniform, grid = _grid(times)
+    uniform, grid, wide = _grid(times, target)
     ref = meter.local
     rest = Pose(skeleton).as_array()
     sources = [(skeleton.index[name], channel) for name, channel in clip.tracks]
@@ -123,7 +146,7 @@ def _compress_one(skeleton, clip, max_error, distances, target, shell, mesh):
         cache.update({key: (tols[key], enc) for key, enc in zip(todo, done)})
         stored = {key: cache[key][1] for key in sources if cache[key][1] is not None}
         compressed = (_rigedit_clip if target == "rigedit" else _gltf_clip)(
-            skeleton, clip, stored, uniform, grid)
+            skeleton, clip, stored, uniform, grid, wide)
         err = meter.error(compressed)
         worst = err.max(axis=0)
         if worst.max() <= max_error:
@@ -163,18 +186,18 @@ def _row(clip, compressed, err, frames, attempts, sources, skeleton):
                     "omitted": sources - animated - constant}, keys, attempts)
 
 
-def _rigedit_clip(skeleton, clip, stored, uniform, grid):
+def _rigedit_clip(skeleton, clip, stored, uniform, grid, wide):
     constant = [tr for tr in stored.values() if tr.keys is None]
     animated = [tr for tr in stored.values() if tr.keys is not None]
     layout = ClipLayout(clip.name, float(clip.duration), clip.loop, grid, uniform,
-                        constant, animated)
+                        constant, animated, wide)
     packed = CompressedClip(skeleton, write_clip(layout))
     if load("reduce_kernels") is not None:   # numba is in already: check with the kernels
         packed.use_kernels()
     return packed
 
 
-def _gltf_clip(skeleton, clip, stored, uniform, grid):
+def _gltf_clip(skeleton, clip, stored, uniform, grid, wide=False):
     tracks, kinds = {}, dict.fromkeys(("rotation", "translation", "scale", "times",
                                        "header"), 0)
     for (j, channel), (times, values) in stored.items():

@@ -42,6 +42,9 @@ VERSION = 1
 DEFAULT_MAX_ERROR = 1e-4
 #: Largest .rgc file read (bytes): a bound on what a file can make rigedit allocate.
 MAX_FILE_BYTES = 1 << 31
+#: Largest rest translation, rotation component or scale read (metres, units): beyond any
+#: rig, and small enough that forward kinematics stays finite.
+MAX_REST_VALUE = 1e9
 
 
 def _section(tag, payload):
@@ -70,6 +73,12 @@ def _read_skeleton(payload):
     rest = [r.floats(count * w, what, "<f8").reshape(count, w)
             for w, what in ((3, "rest translations"), (4, "rest rotations"), (3, "rest scales"))]
     deform = np.frombuffer(r.take(count, "deform flags"), dtype=np.uint8) > 0
+    # checked here, not by Skeleton: 1e300 is finite but overflows the quaternion's norm
+    if not all(np.all(np.abs(a) <= MAX_REST_VALUE) for a in rest):   # also refuses NaN
+        raise LayoutError(f"skeleton: a rest value is not finite or beyond "
+                          f"{MAX_REST_VALUE:g}")
+    if count and np.min(np.linalg.norm(rest[1], axis=1)) < 1e-6:
+        raise LayoutError("skeleton: a rest rotation is not a rotation (zero quaternion)")
     if r.at != len(payload):
         raise LayoutError(f"skeleton: {len(payload) - r.at} bytes after its end")
     return Skeleton(names, parents, *rest, deform=deform)

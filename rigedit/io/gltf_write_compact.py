@@ -120,7 +120,9 @@ def is_rest(track, rest):
 def same_channels(clips):
     """Every clip with the same channels: those that hold something other than the rest in
     some clip (a channel at its rest everywhere is left out); a clip without one of them, or
-    with it at the rest, gets one key at the rest.
+    with it at the rest, gets one key at the rest. When no channel holds anything but the rest,
+    every clip keys its root's rotation at the rest (a glTF animation has at least one
+    channel).
 
     Why: a viewer that plays one animation after another may keep, on a channel the new one
     does not key, what the old one left there (Blender does); the spec's "the node's own TRS"
@@ -132,6 +134,10 @@ def same_channels(clips):
         for (joint, channel), tr in clip.tracks.items():
             if not is_rest(tr, rest_value(clip.skeleton, joint, channel)):
                 keyed.setdefault((joint, channel), None)
+    if not keyed and clips:
+        # every clip at its rest: an animation needs a channel (one without any is no glTF
+        # animation, and the clip would be lost), so each keys its root's rotation at rest
+        keyed[(next(iter(clips.values())).skeleton.names[0], "rotation")] = None
     out = {}
     for name, clip in clips.items():
         sk = clip.skeleton
