@@ -33,6 +33,11 @@ SPARSE_RATES = (30, 24, 25, 60, 50, 120)
 #: At most this many frames are checked per clip (a bound on memory: 10 floats per joint per
 #: frame); a longer clip at its rate is an error rather than an allocation the size it claims.
 MAX_FRAMES = 2_000_000
+#: Two times under a microsecond apart are one frame unless the pose changes between them
+#: by more than JUMP times what its speed over the frame before or after gives, plus
+#: SAME_POSE (metres, quaternion components, scale): a jump.
+JUMP = 10.0
+SAME_POSE = 1e-6
 #: Columns of a channel in a (..., 10) local pose row.
 COLUMNS = {"translation": slice(0, 3), "rotation": slice(3, 7), "scale": slice(7, 10)}
 
@@ -79,9 +84,24 @@ def frame_times(clip, rate=None):
         gap = np.minimum(np.abs(keys[near] - grid), np.abs(keys[near - 1] - grid)) \
             if len(keys) > 1 else np.abs(keys[0] - grid)
         grid = grid[gap > 0.01 / rate]
-    # every distinct key time stays a frame, however close to the one before: two keys 1e-7 s
-    # apart are a jump the source plays (the grid times near a key were dropped above)
-    return np.union1d(grid, keys)
+    times = np.union1d(grid, keys)
+    close = np.flatnonzero(np.diff(times) <= KEY_TOLERANCE) + 1
+    if len(close):
+        # a time within a microsecond of the one before is the same frame where the clip
+        # moves between them as it moves around them (tracks keyed a few ns apart: an FBX's
+        # tick conversion), and a frame of its own where it jumps (a jump baked as two keys
+        # 1e-7 s apart): a change over the gap beyond JUMP times what the pose's speed over
+        # the frame period before or after gives it
+        a, b = times[close - 1], times[close]
+        step = 1.0 / rate
+        p = sample_local(clip, np.concatenate([a - step, a, b, b + step]))
+        before, pa, pb, after = np.split(p.reshape(len(p), -1), 4)
+        change = np.abs(pb - pa)
+        speed = np.maximum(np.abs(pa - before), np.abs(after - pb))
+        expected = speed * ((b - a) / step)[:, None]
+        jump = np.any(change > JUMP * expected + SAME_POSE, axis=1)
+        times = np.delete(times, close[~jump])
+    return times
 
 
 def local_times(duration, loop, times):

@@ -113,3 +113,21 @@ def test_gltf_target_times_stay_strictly_increasing():
     clip = _jump_clip(sk, np.r_[np.linspace(0, 100, 7), 100 + 2e-6, 101.0])
     with pytest.raises(ValueError, match="cannot hold max_error"):
         compress_clips(sk, {"take": clip}, max_error=BOUND, target="gltf")
+
+
+def test_tracks_keyed_nanoseconds_apart_stay_one_frame():
+    """Tracks whose keys are a few ns apart (an FBX's tick conversion: Mixamo's clip has 461
+    such pairs) are one frame each, as before: no doubled frames, the 30 Hz grid kept."""
+    sk = chain(4, 0.1)
+    t = np.arange(60) / 30.0
+    tracks = {}
+    for j, name in enumerate(sk.names):
+        jitter = t + (7e-9 * j if j % 2 else 0.0)
+        tracks[(name, "rotation")] = Track("rotation", jitter, smooth_rotations(60, seed=j))
+    clip = Clip("take", sk, tracks)
+    assert len(clip.key_times()) > 60
+    assert len(frame_times(clip)) == 60
+    result = compress_clips(sk, {"take": clip}, max_error=BOUND)
+    assert result.clips["take"].layout.uniform is not None
+    err = independent_error(sk, clip, result.clips["take"], clip.key_times())
+    assert err <= BOUND * (1 + 1e-6)
