@@ -9,6 +9,7 @@ from .layout import EncodedTrack
 from .quantise import (OTHERS, PER_KEY, VectorCode, quantise_rotations, quantise_vectors,
                        rotation_from_three, segment_vectors)
 from .reduce import reduce_keys
+from .reduce_cubic import reduce_cubic
 
 __all__ = ["QUANTISE_SHARE", "encode_tracks", "gltf_tracks", "gltf_values"]
 
@@ -20,6 +21,10 @@ QUANTISE_SHARE = 0.8
 #: A track is segmented when that takes under this part of its unsegmented bits (at every
 #: frame, headers counted): key reduction then keeps fewer keys a segment header pays for.
 SEGMENT_GAIN = 0.9
+#: Frames a clip needs before its tracks are also tried with Catmull-Rom keys.
+MIN_CUBIC_FRAMES = 4
+#: Try Catmull-Rom keys at all (off: every track linear; the benchmark measures the gain).
+CUBIC_KEYS = True
 
 
 def _classified(values, rest, tol, rotation, measured=None):
@@ -29,15 +34,21 @@ def _classified(values, rest, tol, rotation, measured=None):
     return kind, value
 
 
+def _groups(animated):
+    """Indices of ``animated`` by kind: rotations, then vectors (those there are)."""
+    for rotation in (True, False):
+        group = [i for i, a in enumerate(animated) if a[3] == rotation]
+        if group:
+            yield rotation, group
+
+
 def _reduce_groups(grid, animated):
     """Reduce the keys of many tracks at once, one :func:`reduce_keys` call per kind
     (rotations, vectors). ``animated``: list of (values (F, C), decoded (F, C), tol,
-    rotation); returns the kept frame indices of each."""
+    rotation[, values at the half-frames (F - 1, C)]); returns the kept frame indices of
+    each."""
     keys = [None] * len(animated)
-    for rotation in (True, False):
-        group = [i for i, a in enumerate(animated) if a[3] == rotation]
-        if not group:
-            continue
+    for rotation, group in _groups(animated):
         keep = reduce_keys(grid, np.stack([animated[i][0] for i in group]),
                            np.stack([animated[i][1] for i in group]),
                            np.array([animated[i][2] for i in group]), rotation)
@@ -46,7 +57,30 @@ def _reduce_groups(grid, animated):
     return keys
 
 
-def encode_tracks(items, grid):
+def _fewest_keys(grid, animated):
+    """Per track, ``(keys, cubic)``: Catmull-Rom keys (:mod:`.reduce_cubic`, checked at the
+    half-frames too) where they are fewer than the linear ones and hold, else the linear
+    keys. A track without its half-frame values (an ``animated`` item of 4, or None there)
+    and every track of a clip of a handful of frames is linear."""
+    linear = _reduce_groups(grid, animated)
+    out = [(k, False) for k in linear]
+    if len(grid) < MIN_CUBIC_FRAMES or not CUBIC_KEYS:
+        return out
+    tried = [i for i, a in enumerate(animated) if len(a) > 4 and a[4] is not None]
+    for rotation, sub in _groups([animated[i] for i in tried]):
+        group = [tried[i] for i in sub]
+        keep, ok = reduce_cubic(grid, np.stack([animated[i][0] for i in group]),
+                                np.stack([animated[i][1] for i in group]),
+                                np.array([animated[i][2] for i in group]), rotation,
+                                np.stack([animated[i][4] for i in group]))
+        for row, good, i in zip(keep, ok, group):
+            cubic = np.flatnonzero(row)
+            if good and len(cubic) < len(linear[i]):
+                out[i] = (cubic, True)
+    return out
+
+
+def encode_tracks(items, grid, mids=None):
     """The stored form of tracks of one clip for rigedit's format, all reduced together.
 
     Parameters
@@ -57,6 +91,10 @@ def encode_tracks(items, grid):
         :func:`~rigedit.compression.constant.spread`.
     grid : (F,) float64
         The frame times as decoded.
+    mids : list of (F - 1, C) float64 or None, optional
+        Each track at the half-frames (:func:`~rigedit.compression.reduce_cubic.half_frames`):
+        given, a track may take Catmull-Rom keys (checked there too); else (None) its keys are
+        linear.
 
     Returns
     -------
@@ -85,15 +123,17 @@ def encode_tracks(items, grid):
             code = quantise_vectors(values, 2 * quant / np.sqrt(3))
             segments = _segmented(values, code)
             decoded = code.values() if segments is None else segments.values
-        animated.append((values, decoded, tol, rotation))
+        animated.append((values, decoded, tol, rotation) if mids is None else
+                        (values, decoded, tol, rotation, mids[i]))
         codes.append((i, mode, code, dropped, segments))
-    for keys, (i, mode, code, dropped, segments) in zip(_reduce_groups(grid, animated), codes):
+    for (keys, cubic), (i, mode, code, dropped, segments) in zip(_fewest_keys(grid, animated),
+                                                                codes):
         joint, channel = items[i][:2]
         stored = code.codes if segments is None else segments.codes
         out[i] = EncodedTrack(joint, channel, keys=keys, mode=mode,
                               code=VectorCode(code.lo, code.ext, code.bits, stored[keys]),
                               dropped=None if dropped is None else dropped[keys],
-                              segments=segments)
+                              segments=segments, cubic=cubic)
     return out
 
 

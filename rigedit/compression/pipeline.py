@@ -20,13 +20,14 @@ from ..model.pose import Pose
 from ..progress import adapt
 from .budget import Budget
 from .compressed_clip import CompressedClip, KeyedClip
-from .encode import encode_tracks, gltf_tracks
+from .encode import MIN_CUBIC_FRAMES, encode_tracks, gltf_tracks
 from .constant import spread
 from .error import ErrorMeter
 from .kernels import load
 from .frames import COLUMNS, frame_times
 from .layout import ClipLayout, grid_times, key_code, write_clip
 from .quantise import PER_KEY, SEGMENT, SEGMENT_HEADER_BITS
+from .reduce_cubic import half_frames
 from .report import RAW_BYTES_PER_JOINT_FRAME, ClipRow, CompressionReport
 from .virtual import DEFAULT_SHELL, check_shell, shell_distances
 
@@ -108,24 +109,35 @@ def _compress_one(skeleton, clip, max_error, distances, target, shell, mesh):
     budget = Budget(skeleton, max_error, distances)
     uniform, grid = _grid(times)
     ref = meter.local
+    # the source halfway between frames: Catmull-Rom keys are checked there too
+    mid_meter = ErrorMeter(skeleton, clip, half_frames(times), shell, mesh) \
+        if target == "rigedit" and len(times) >= MIN_CUBIC_FRAMES else None
     rest = Pose(skeleton).as_array()
     sources = [(skeleton.index[name], channel) for name, channel in clip.tracks]
     cache = {}
     spreads = {(j, c): spread(ref[:, j, COLUMNS[c]], rest[j, COLUMNS[c]], c == "rotation")
                for j, c in sources}
     best, relax = None, RELAX_ROUNDS
+    linear = np.zeros(len(skeleton), dtype=bool)     # joints kept to linear keys
     for attempt in range(1, MAX_ATTEMPTS + 1):
-        tols = {(j, c): budget.tolerance(j, c) for j, c in sources}
+        tols = {(j, c): (budget.tolerance(j, c), bool(linear[j])) for j, c in sources}
         todo = [(j, c) for j, c in sources if cache.get((j, c), (None,))[0] != tols[(j, c)]]
-        encode = encode_tracks if target == "rigedit" else gltf_tracks
-        done = encode([(j, c, ref[:, j, COLUMNS[c]], rest[j, COLUMNS[c]], tols[(j, c)],
-                        spreads[(j, c)]) for j, c in todo], grid)
+        batch = [(j, c, ref[:, j, COLUMNS[c]], rest[j, COLUMNS[c]], tols[(j, c)][0],
+                  spreads[(j, c)]) for j, c in todo]
+        if target == "gltf":
+            done = gltf_tracks(batch, grid)
+        else:
+            done = encode_tracks(batch, grid, None if mid_meter is None else [
+                None if linear[j] else mid_meter.local[:, j, COLUMNS[c]] for j, c in todo])
         cache.update({key: (tols[key], enc) for key, enc in zip(todo, done)})
         stored = {key: cache[key][1] for key in sources if cache[key][1] is not None}
         compressed = (_rigedit_clip if target == "rigedit" else _gltf_clip)(
             skeleton, clip, stored, uniform, grid)
         err = meter.error(compressed)
         worst = err.max(axis=0)
+        if worst.max() <= max_error and _cubic_strays(skeleton, compressed, mid_meter,
+                                                      max_error, linear):
+            continue
         if worst.max() <= max_error:
             if best is None or compressed.nbytes < best[0].nbytes:
                 best = (compressed, err, attempt)
@@ -141,6 +153,36 @@ def _compress_one(skeleton, clip, max_error, distances, target, shell, mesh):
     compressed, err, attempt = best
     return compressed, err, _row(clip, compressed, err, len(times), attempt, len(sources),
                                  skeleton)
+
+
+def _cubic_strays(skeleton, compressed, mid_meter, max_error, linear):
+    """Whether the clip's Catmull-Rom keys take a joint past the bound halfway between
+    frames; if so, the joints with cubic keys on the path from each such joint to the root
+    are marked in ``linear`` (J,) bool, to be encoded again with linear keys.
+
+    The reducer holds each cubic track to its share at the half-frames (:mod:`.reduce_cubic`)
+    but shares add up in model space. Linear keys are not checked here: between two frames
+    they are straight where the source's frames are joined straight, so the frames hold them;
+    against a source that curves between its frames they stray as the source's own frames
+    do, and no key mends that.
+    """
+    if mid_meter is None or isinstance(compressed, KeyedClip):
+        return False
+    cubic = np.zeros(len(skeleton), dtype=bool)
+    for tr in compressed.layout.animated:
+        cubic[tr.joint] |= tr.cubic
+    if not cubic.any():
+        return False
+    over = np.flatnonzero(mid_meter.error(compressed).max(axis=0) > max_error)
+    path = np.zeros(len(skeleton), dtype=bool)
+    for j in over:
+        j = int(j)
+        while j >= 0:
+            path[j] = True
+            j = int(skeleton.parents[j])
+    mend = path & cubic & ~linear
+    linear |= mend
+    return bool(mend.any())
 
 
 def _row(clip, compressed, err, frames, attempts, sources, skeleton):
