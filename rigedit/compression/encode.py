@@ -11,7 +11,7 @@ from .quantise import (OTHERS, PER_KEY, VectorCode, quantise_rotations, quantise
 from .reduce import reduce_keys
 from .reduce_cubic import reduce_cubic
 
-__all__ = ["QUANTISE_SHARE", "encode_tracks", "gltf_tracks", "gltf_values"]
+__all__ = ["QUANTISE_SHARE", "encode_tracks", "gltf_tracks", "gltf_values", "dense_is_cheaper"]
 
 #: Part of a track's tolerance its quantisation may take; key reduction gets the rest (it
 #: measures the quantised values, so the two together stay within the tolerance). One bit
@@ -174,6 +174,17 @@ def gltf_tracks(items, grid):
             else stored
         animated.append((values, decoded, tol, rotation))
         stored_all.append((i, stored))
-    for keys, (i, stored) in zip(_reduce_groups(grid, animated), stored_all):
+    every = np.arange(len(grid))
+    for keys, (i, stored), a in zip(_reduce_groups(grid, animated), stored_all, animated):
+        if dense_is_cheaper(len(keys), len(grid), a[3]):
+            keys = every
         out[i] = grid[keys], stored[keys]
     return out
+
+
+def dense_is_cheaper(keys, frames, rotation):
+    """Whether a glTF track of ``keys`` reduced keys costs more than keying every frame: its
+    own key times cost 4 bytes a key, while every frame's times are one accessor that all
+    such tracks share (int16 rotations: 8 bytes a key, float32 vectors 12)."""
+    value = 8 if rotation else 12
+    return keys * (value + 4) > frames * value

@@ -219,11 +219,14 @@ def _rigedit_clip(skeleton, clip, stored, uniform, grid):
 def _gltf_clip(skeleton, clip, stored, uniform, grid):
     tracks, kinds = {}, dict.fromkeys(("rotation", "translation", "scale", "times",
                                        "header"), 0)
+    seen = set()     # a list of key times is one accessor, shared (io/gltf_write_compact)
     for (j, channel), (times, values) in stored.items():
         tracks[(skeleton.names[j], channel)] = Track(channel, times.astype(np.float32),
                                                      values, _GLTF_MODE[channel])
         kinds[channel] += len(times) * (8 if channel == "rotation" else 12)
-        kinds["times"] += 4 * len(times)
+        key = times.astype(np.float32).tobytes()
+        kinds["times"] += 0 if key in seen else 4 * len(times)
+        seen.add(key)
     keyed = KeyedClip(Clip(clip.name, skeleton, tracks, clip.duration, clip.loop),
                       sum(kinds.values()))
     keyed.kinds = kinds

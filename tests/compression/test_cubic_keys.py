@@ -210,3 +210,28 @@ def test_noisy_mocap_keeps_linear_where_the_cubic_does_not_pay():
     root = [tr for tr in layout.animated if tr.channel == "translation"][0]
     assert not root.cubic              # white noise: every frame a key either way
     assert result.report.max_error <= 1e-4
+
+
+def test_gltf_tracks_dense_after_reduction_key_every_frame_and_share_times():
+    from rigedit.compression.encode import dense_is_cheaper
+
+    # int16 rotations: 8 bytes a key, own times 4 more; every frame's times are shared
+    assert dense_is_cheaper(70, 100, True) and not dense_is_cheaper(60, 100, True)
+    assert dense_is_cheaper(80, 100, False) and not dense_is_cheaper(70, 100, False)
+    sk = chain(8, 0.1)
+    clip = mocap_clip(sk, frames=120)
+    t = np.arange(120) / 120.0
+    noise = np.random.default_rng(3).normal(0, 0.01, (120, 3))     # keeps nearly every frame
+    clip.tracks[(sk.names[0], "translation")] = Track("translation", t, noise)
+    result = compress_clips(sk, {"take": clip}, max_error=1e-4, target="gltf")
+    tracks = result.clips["take"].clip.tracks
+    lengths = {k: len(tr.times) for k, tr in tracks.items() if len(tr.times) > 1}
+    dense = [k for k, n in lengths.items() if n == 120]
+    assert (sk.names[0], "translation") in dense
+    assert all(n == 120 or not dense_is_cheaper(n, 120, k[1] == "rotation")
+               for k, n in lengths.items())
+    # the report counts a shared list of times once
+    assert result.report.clips[0].bytes_by_kind["times"] == 4 * sum(
+        len(v) for v in {tracks[k].times.astype(np.float32).tobytes(): tracks[k].times
+                         for k in lengths}.values())
+    assert result.report.max_error <= 1e-4
