@@ -13,14 +13,35 @@ import numpy as np
 __all__ = ["reduce_many", "reduce_many_cubic"]
 
 
+@numba.njit(cache=True, inline="always")
+def _line_error(vals, ref_row, a, b, u, flip, rotation, q):
+    """Distance of the LERP / NLERP of keys a, b at fraction u from ``ref_row``."""
+    c = q.shape[0]
+    n = 0.0
+    for m in range(c):
+        q[m] = vals[a, m] + (flip * vals[b, m] - vals[a, m]) * u
+        n += q[m] * q[m]
+    scale = 1.0 / np.sqrt(n) if rotation and n > 0 else 1.0
+    e1 = 0.0
+    e2 = 0.0
+    for m in range(c):
+        v = q[m] * scale
+        e1 += (v - ref_row[m]) ** 2
+        e2 += (v + ref_row[m]) ** 2
+    return np.sqrt(min(e1, e2)) if rotation else np.sqrt(e1)
+
+
 @numba.njit(cache=True)
-def _span_worst(times, ref, vals, a, b, rotation):
-    """Worst frame strictly inside (a, b) and its error, interpolating keys a and b."""
+def _span_worst(times, ref, vals, a, b, rotation, mids, mid_ref, mid_arc3):
+    """The frame to key in span (a, b), interpolating keys a and b, and its error: the worst
+    of the frames strictly inside and, where the span turns far enough (its quaternion arc
+    cubed over ``mid_arc3``), of the half-frames (``mids``, may be empty) a key can mend (not
+    the one between two neighbouring keys; :mod:`rigedit.compression.reduce`)."""
     c = ref.shape[1]
     worst, at = -1.0, -1
     flip = 1.0
+    d = 0.0
     if rotation:
-        d = 0.0
         for m in range(c):
             d += vals[a, m] * vals[b, m]
         flip = -1.0 if d < 0 else 1.0
@@ -28,26 +49,24 @@ def _span_worst(times, ref, vals, a, b, rotation):
     q = np.empty(c)
     for f in range(a + 1, b):
         u = (times[f] - times[a]) / span if span > 0 else 0.0
-        n = 0.0
-        for m in range(c):
-            q[m] = vals[a, m] + (flip * vals[b, m] - vals[a, m]) * u
-            n += q[m] * q[m]
-        scale = 1.0 / np.sqrt(n) if rotation and n > 0 else 1.0
-        e1 = 0.0
-        e2 = 0.0
-        for m in range(c):
-            v = q[m] * scale
-            e1 += (v - ref[f, m]) ** 2
-            e2 += (v + ref[f, m]) ** 2
-        e = np.sqrt(min(e1, e2)) if rotation else np.sqrt(e1)
+        e = _line_error(vals, ref[f], a, b, u, flip, rotation, q)
         if e > worst:
             worst, at = e, f
+    if mids.shape[0] and b - a > 1 and np.arccos(min(abs(d), 1.0)) ** 3 > mid_arc3:
+        for g in range(a, b):
+            u = (mids[g] - times[a]) / span if span > 0 else 0.0
+            e = _line_error(vals, mid_ref[g], a, b, u, flip, rotation, q)
+            if e > worst:
+                worst, at = e, (g if g > a else g + 1)
     return at, worst
 
 
 @numba.njit(cache=True)
-def reduce_many(times, ref, vals, tol, rotation, keep):
-    """``keep`` (T, F) bool filled for tracks ref, vals (T, F, C) at tolerances tol (T,)."""
+def reduce_many(times, ref, vals, tol, rotation, mids, mid_ref, keep, mid_check):
+    """``keep`` (T, F) bool filled for tracks ref, vals (T, F, C) at tolerances tol (T,);
+    ``mids`` (F - 1,) half-frame times and ``mid_ref`` (T, F - 1, C) the source there (both
+    empty: frames only), measured in spans whose quaternion arc cubed exceeds ``mid_check``
+    tolerances."""
     t, f = keep.shape
     stack = np.empty((2 * f + 2, 2), dtype=np.int64)
     for k in range(t):
@@ -62,7 +81,8 @@ def reduce_many(times, ref, vals, tol, rotation, keep):
             a, b = stack[top, 0], stack[top, 1]
             if b - a < 2:
                 continue
-            at, worst = _span_worst(times, ref[k], vals[k], a, b, rotation)
+            at, worst = _span_worst(times, ref[k], vals[k], a, b, rotation, mids, mid_ref[k],
+                                    mid_check * tol[k])
             if worst > tol[k]:
                 keep[k, at] = True
                 stack[top, 0], stack[top, 1] = a, at
