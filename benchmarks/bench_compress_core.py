@@ -1,8 +1,9 @@
 """Animation compression core (issue 20): speed against a reference measured in the same run,
 and the ratio and error on the shared data, step by step.
 
-Run: ``.venv/bin/python benchmarks/bench_compress_core.py [--speed] [--ratio]`` (both by
-default). Figures go into docs/compression.md with the date and the machine's load.
+Run: ``.venv/bin/python benchmarks/bench_compress_core.py [--speed] [--ratio] [--cubic]``
+(speed and ratio by default; ``--cubic``: the gain of Catmull-Rom keys, on and off in one
+run). Figures go into docs/compression.md with the date and the machine's load.
 
 **Speed** (wall time, best of a few repeats, the machine's other work included):
 
@@ -130,16 +131,59 @@ def ratio():
                   f"({rep.ratio:.1f}:1); bytes {rep.bytes_by_kind}")
 
 
+def cubic_gain():
+    """Catmull-Rom keys on and off (``encode.CUBIC_KEYS``) in the same run: the shared clips,
+    and the bundled characters' clips as they are (LINEAR / SLERP keys) and with their keys
+    made ``catmull_rom`` (what an animator's spline clips are)."""
+    from rigedit.animation import Clip
+    from rigedit.compression import encode
+
+    warnings.simplefilter("ignore")
+    assets = HERE.parent / "assets"
+    cases = [(DATA / rel, bounds, False) for rel, bounds in CASES]
+    cases += [(assets / name, (5e-4, 1e-4), spline) for name in ("quadruped", "humanoid")
+              for spline in (False, True)]
+    for path, bounds, spline in cases:
+        if not path.exists():
+            print(f"{path}: missing, skipped")
+            continue
+        rig = rigedit.load_rig(path)
+        clips = rig.clips
+        if spline:
+            clips = {n: Clip(n, rig.skeleton, {k: tr.with_interpolation("catmull_rom")
+                                               for k, tr in c.tracks.items()},
+                             c.duration, c.loop) for n, c in clips.items()}
+        for bound in bounds:
+            row = []
+            for on in (False, True):
+                encode.CUBIC_KEYS = on
+                t = time.perf_counter()
+                result = compress_clips(rig.skeleton, clips, max_error=bound)
+                took = time.perf_counter() - t
+                cubic = sum(tr.cubic for c in result.clips.values()
+                            for tr in c.layout.animated)
+                tracks = sum(len(c.layout.animated) for c in result.clips.values())
+                row.append(f"{result.report.ratio:.2f}:1 ({cubic}/{tracks} cubic, "
+                           f"{took:.2f} s)")
+            encode.CUBIC_KEYS = True
+            print(f"{path.name}{' (catmull_rom keys)' if spline else ''} at {bound * 100:g} "
+                  f"cm: linear only {row[0]}; with Catmull-Rom keys {row[1]}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--speed", action="store_true")
     parser.add_argument("--ratio", action="store_true")
+    parser.add_argument("--cubic", action="store_true",
+                        help="the gain of Catmull-Rom keys (on and off in one run)")
     args = parser.parse_args()
-    both = not (args.speed or args.ratio)
+    both = not (args.speed or args.ratio or args.cubic)
     if args.speed or both:
         speed()
     if args.ratio or both:
         ratio()
+    if args.cubic:
+        cubic_gain()
 
 
 if __name__ == "__main__":

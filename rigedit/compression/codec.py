@@ -4,15 +4,17 @@ What is decoded once, when a clip is opened: the headers and each track's key fr
 a few bytes per key); the values stay packed. A pose at time ``t`` is then, for all animated
 tracks at once: one ``searchsorted`` over every track's key times (each track's times shifted
 by its own offset so one sorted array holds them all), the two neighbouring keys' fields read
-from the 32-bit words (two words per field, a shift and a mask), dequantised, the dropped
-rotation component rebuilt, LERP / NLERP on the shortest path, and a scatter into the pose
-array. A batch of N times runs the same operations on (N, tracks) arrays.
+from the 32-bit words (two words per field, a shift and a mask; four keys for a track of
+Catmull-Rom keys), dequantised, the dropped rotation component rebuilt, LERP / NLERP on the
+shortest path or the cubic (:mod:`.cubic`), and a scatter into the pose array. A batch of N
+times runs the same operations on (N, tracks) arrays.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from .bits import read_fields, words_of
+from .cubic import hermite_cr
 from .frames import COLUMNS
 from .kernels import load, loaded
 from .quantise import OTHERS, PER_KEY, SEGMENT, segment_range
@@ -81,18 +83,20 @@ class ClipDecoder:
         self.vec_target = (joint[self.vec] * 10 + first[self.vec])[:, None] + np.arange(3)
         self.rot_target = (joint[self.rot] * 10 + 3)[:, None] + np.arange(4)
         self.rot_per_key = per_key[self.rot]
+        cubic = np.array([tr.cubic for tr in tracks], dtype=bool)
+        self.vec_cubic, self.rot_cubic = cubic[self.vec], cubic[self.rot]
         self.itab = np.column_stack([
             self.start, lengths, lead, rot.astype(np.int64), joint * 10 + first,
-            self.fixed]).astype(np.int64) if self.count else np.zeros((0, 6), dtype=np.int64)
+            self.fixed, cubic.astype(np.int64)]).astype(np.int64) if self.count else \
+            np.zeros((0, 7), dtype=np.int64)
         self.sitab = np.ascontiguousarray(np.column_stack([
             self.seg_offset, self.seg_first, self.seg_stride, self.seg_field,
             self.seg_bits]).astype(np.int64))
         self.sftab = np.ascontiguousarray(np.column_stack([self.seg_lo, self.seg_scale]))
         self.compiled = None
-        # the compiled single-pose path's key cache: the key each track decoded last, and
-        # that key's and the next one's values (keys never change, so it never goes stale)
-        self._cache = (np.full(self.count, -1, dtype=np.int64), np.zeros((self.count, 4)),
-                       np.zeros((self.count, 4)))
+        # the compiled single-pose path's key cache: the span each track decoded last, and
+        # its keys i-1 .. i+2 (keys never change, so it never goes stale)
+        self._cache = (np.full(self.count, -1, dtype=np.int64), np.zeros((self.count, 4, 4)))
 
     def _segment_tables(self, tracks, offsets, lead):
         """Per segment of stored keys (a whole track when it is not segmented): bit offset of
@@ -181,16 +185,23 @@ class ClipDecoder:
         n = len(t)
         pos = np.searchsorted(self.shifted, t[:, None] + self.shift[None, :], side="right") - 1
         i = np.clip(pos, self.start, self.last)                       # (N, T)
-        t0, t1 = self.key_times[i], self.key_times[i + 1]
-        u = np.clip((t[:, None] - t0) / (t1 - t0), 0.0, 1.0)
-        key = i[..., None] + np.arange(2)                             # (N, T, 2)
-        at, comps = self._fields(key, np.arange(self.count)[:, None])  # (N, T, 2, 3)
+        # keys i-1 .. i+2 of each track, clamped to the track (the cubic's neighbours; a
+        # clamped one gives the end key's secant)
+        key = np.clip(i[..., None] + np.arange(-1, 3), self.start[:, None],
+                      (self.last + 1)[:, None])                       # (N, T, 4)
+        kt = self.key_times[key]
+        u = np.clip((t[:, None] - kt[..., 1]) / (kt[..., 2] - kt[..., 1]), 0.0, 1.0)
+        at, comps = self._fields(key, np.arange(self.count)[:, None])  # (N, T, 4, 3)
         vec = comps[:, self.vec]
-        a, b = vec[:, :, 0], vec[:, :, 1]
-        uv = u[:, self.vec, None]
-        vectors = a + (b - a) * uv
-        three = comps[:, self.rot]                                    # (N, Tr, 2, 3)
-        dropped = np.broadcast_to(self.fixed[self.rot][:, None], (n, len(self.rot), 2))
+        a, b = vec[:, :, 1], vec[:, :, 2]
+        vectors = a + (b - a) * u[:, self.vec, None]
+        if self.vec_cubic.any():
+            c = self.vec_cubic
+            kv = kt[:, self.vec[c]]
+            vectors[:, c] = hermite_cr(*(kv[..., m] for m in range(4)),
+                                       *(vec[:, c, m] for m in range(4)), t[:, None], False)
+        three = comps[:, self.rot]                                    # (N, Tr, 4, 3)
+        dropped = np.broadcast_to(self.fixed[self.rot][:, None], (n, len(self.rot), 4))
         if self.rot_per_key.any():
             idx = read_fields(self.words, at[:, self.rot], 2).astype(np.int64)
             dropped = np.where(self.rot_per_key[:, None], idx, dropped)
@@ -198,10 +209,15 @@ class ClipDecoder:
         q = np.empty(three.shape[:-1] + (4,))
         np.put_along_axis(q, dropped[..., None], w[..., None], axis=-1)
         np.put_along_axis(q, OTHERS[dropped], three, axis=-1)
-        qa, qb = q[:, :, 0], q[:, :, 1]
+        qa, qb = q[:, :, 1], q[:, :, 2]
         qb = np.where(np.sum(qa * qb, axis=-1, keepdims=True) < 0, -qb, qb)
         rq = qa + (qb - qa) * u[:, self.rot, None]
         rq /= np.linalg.norm(rq, axis=-1, keepdims=True)
+        if self.rot_cubic.any():
+            c = self.rot_cubic
+            kr = kt[:, self.rot[c]]
+            rq[:, c] = hermite_cr(*(kr[..., m] for m in range(4)),
+                                  *(q[:, c, m] for m in range(4)), t[:, None], True)
         return vectors, rq
 
     def local_many(self, t):

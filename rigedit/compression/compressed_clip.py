@@ -7,6 +7,7 @@ from ..animation.clip import Clip
 from ..animation.track import Track
 from ..model.pose import Pose
 from .codec import ClipDecoder, kernels_loaded
+from .cubic import key_tangents
 from .frames import local_times, sample_local
 from .layout import read_clip
 
@@ -107,7 +108,9 @@ class CompressedClip(_Sampled):
 
     def to_clip(self, name=None):
         """A plain :class:`Clip` of the stored keys, dequantised exactly as decoded:
-        ``linear`` translations and scales, ``nlerp`` rotations; a constant track is one key."""
+        ``linear`` translations and scales, ``nlerp`` rotations, ``cubic_spline`` with the
+        Catmull-Rom velocities (:func:`~rigedit.compression.cubic.key_tangents`) for a track
+        of cubic keys; a constant track is one key."""
         sk = self.skeleton
         tracks = {}
         for tr in self.layout.constant:
@@ -115,8 +118,13 @@ class CompressedClip(_Sampled):
                 tr.channel, [0.0], [np.asarray(tr.value, dtype=np.float64)], _MODE[tr.channel])
         for i, tr in enumerate(self.layout.animated):
             times, values = self.decoder.keys(i)
-            tracks[(sk.names[tr.joint], tr.channel)] = Track(tr.channel, times, values,
-                                                             _MODE[tr.channel])
+            if tr.cubic:       # Catmull-Rom keys: the same cubic as a Hermite track
+                values, tangents = key_tangents(times, values, tr.channel == "rotation")
+                track = Track(tr.channel, times, values, "cubic_spline",
+                              np.repeat(tangents[:, None], 2, axis=1))
+            else:
+                track = Track(tr.channel, times, values, _MODE[tr.channel])
+            tracks[(sk.names[tr.joint], tr.channel)] = track
         return Clip(name or self.name, sk, tracks, self.duration, self.loop)
 
     def __repr__(self):

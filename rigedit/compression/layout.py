@@ -14,7 +14,9 @@ constant tracks       varint C, then C x (varint joint, uint8 channel, 3 or 4 fl
 animated tracks       varint A, then A track headers:
                       varint joint; uint8 channel (bits 0-1: 0 translation, 1 rotation,
                       2 scale) | rotation mode << 2 (0-3 fixed dropped component, 4 per key)
-                      | 32 when segmented (its values per 16-frame segment);
+                      | 32 when segmented (its values per 16-frame segment)
+                      | 64 when its keys are joined by the Catmull-Rom cubic
+                      (compression/cubic.py) instead of LERP / NLERP;
                       varint K (keys, 2..F); uint8 D (bits per key-frame step, 0: every
                       frame is a key, 255: a bit per frame); per-key rotation: uint8 B (bits of all three
                       components); fixed rotation: 3 uint8 bits, 3 uint16 lo, 3 uint16
@@ -72,6 +74,7 @@ class EncodedTrack:
     dropped: np.ndarray = None
     segments: object = None     # SegmentCode when segmented (writing), the used segments'
     #                             (index, a, b, bits) arrays when read
+    cubic: bool = False         # keys joined by the Catmull-Rom cubic (.cubic), not LERP
 
 
 @dataclass
@@ -119,6 +122,8 @@ def varint(n):
 
 #: Bit of a track's code byte: its values are quantised per segment of frames.
 SEGMENTED = 32
+#: Bit of a track's code byte: its keys are joined by the Catmull-Rom cubic.
+CUBIC = 64
 _HEADER_AT = np.array([0, 8, 16, 24, 32, 40, 48, 53, 58])
 _HEADER_WIDTHS = np.array([8, 8, 8, 8, 8, 8, 5, 5, 5])
 
@@ -163,7 +168,9 @@ def write_clip(layout):
         steps = np.diff(keys)
         dbits = key_code(keys, count)[0]
         segmented = SEGMENTED if tr.segments is not None else 0
-        out += varint(tr.joint) + bytes([CHANNEL_CODES[tr.channel] | (tr.mode << 2) | segmented])
+        cubic = CUBIC if tr.cubic else 0
+        out += varint(tr.joint) + bytes([CHANNEL_CODES[tr.channel] | (tr.mode << 2) | segmented
+                                         | cubic])
         out += varint(len(keys)) + bytes([dbits])
         if tr.mode == PER_KEY:
             out += bytes([int(tr.code.bits[0])])
@@ -310,7 +317,7 @@ def read_clip(blob, num_joints):
         code = r.u8("channel")
         channel, mode, segmented = CHANNEL_NAMES.get(code & 3), (code >> 2) & 7, code & SEGMENTED
         if (channel is None or mode > PER_KEY or (channel != "rotation" and mode)
-                or code > 63 or (segmented and mode == PER_KEY)):
+                or code > 127 or (segmented and mode == PER_KEY)):
             raise LayoutError(f"clip {name!r}: unknown track code {code}")
         keys = r.varint("key count", count)
         dbits = r.u8("key step bits")
@@ -334,7 +341,8 @@ def read_clip(blob, num_joints):
             raise LayoutError(f"clip {name!r}: a track's range or bits are not valid")
         animated.append(EncodedTrack(joint, channel, keys=keys, mode=mode,
                                      code=VectorCode(lo, ext, np.asarray(bits), None),
-                                     segments=True if segmented else None))
+                                     segments=True if segmented else None,
+                                     cubic=bool(code & CUBIC)))
         dbits_all.append(dbits)
     words = r.varint("bit stream length", size // 4)
     stream = bytes(r.take(words * 4, "bit stream"))

@@ -10,6 +10,7 @@ are encoded again, until every frame of the clip holds.
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,14 +25,15 @@ from .encode import encode_tracks, gltf_tracks
 from .constant import spread
 from .error import ErrorMeter
 from .kernels import load
-from .frames import COLUMNS, frame_times
+from .frames import COLUMNS, frame_times, sample_local
 from .layout import ClipLayout, grid_times, key_code, write_clip
 from .quantise import PER_KEY, SEGMENT, SEGMENT_HEADER_BITS
+from .reduce_cubic import half_frames
 from .report import RAW_BYTES_PER_JOINT_FRAME, ClipRow, CompressionReport
 from .virtual import DEFAULT_SHELL, check_shell, shell_distances
 
 __all__ = ["TARGETS", "SECTION_BYTES", "CompressionResult", "compress_clips",
-           "check_max_error"]
+           "check_max_error", "HalfFrameWarning"]
 
 TARGETS = ("rigedit", "gltf")
 #: Bytes a clip's section header takes in a .rgc file (tag, length, CRC32), counted in the
@@ -131,24 +133,38 @@ def _compress_one(skeleton, clip, max_error, distances, target, shell, mesh):
     budget = Budget(skeleton, max_error, distances)
     uniform, grid, wide = _grid(times, target)
     ref = meter.local
+    halves = HalfFrames(skeleton, clip, times, shell, mesh) if len(times) > 1 else None
     rest = Pose(skeleton).as_array()
     sources = [(skeleton.index[name], channel) for name, channel in clip.tracks]
     cache = {}
     spreads = {(j, c): spread(ref[:, j, COLUMNS[c]], rest[j, COLUMNS[c]], c == "rotation")
                for j, c in sources}
-    best, relax = None, RELAX_ROUNDS
+    best, relax, frames_only = None, RELAX_ROUNDS, None
+    linear = np.zeros(len(skeleton), dtype=bool)     # joints kept to linear keys
     for attempt in range(1, MAX_ATTEMPTS + 1):
-        tols = {(j, c): budget.tolerance(j, c) for j, c in sources}
+        tols = {(j, c): (budget.tolerance(j, c), bool(linear[j])) for j, c in sources}
         todo = [(j, c) for j, c in sources if cache.get((j, c), (None,))[0] != tols[(j, c)]]
-        encode = encode_tracks if target == "rigedit" else gltf_tracks
-        done = encode([(j, c, ref[:, j, COLUMNS[c]], rest[j, COLUMNS[c]], tols[(j, c)],
-                        spreads[(j, c)]) for j, c in todo], grid)
+        batch = [(j, c, ref[:, j, COLUMNS[c]], rest[j, COLUMNS[c]], tols[(j, c)][0],
+                  spreads[(j, c)]) for j, c in todo]
+        mids = None if halves is None else [halves.meter.local[:, j, COLUMNS[c]]
+                                            for j, c in todo]
+        if target == "gltf":
+            done = gltf_tracks(batch, grid, mids)
+        else:
+            done = encode_tracks(batch, grid, mids, [not linear[j] for j, c in todo])
         cache.update({key: (tols[key], enc) for key, enc in zip(todo, done)})
         stored = {key: cache[key][1] for key in sources if cache[key][1] is not None}
         compressed = (_rigedit_clip if target == "rigedit" else _gltf_clip)(
             skeleton, clip, stored, uniform, grid, wide)
         err = meter.error(compressed)
         worst = err.max(axis=0)
+        if halves is not None and worst.max() <= max_error:
+            between = halves.excess(compressed)
+            if frames_only is None or between.max() < frames_only[3]:
+                frames_only = (compressed, err, attempt, between.max())
+            if _cubic_strays(skeleton, compressed, between > max_error, linear):
+                continue
+            worst = np.maximum(worst, between)
         if worst.max() <= max_error:
             if best is None or compressed.nbytes < best[0].nbytes:
                 best = (compressed, err, attempt)
@@ -158,12 +174,72 @@ def _compress_one(skeleton, clip, max_error, distances, target, shell, mesh):
             budget.relax(worst)
         else:
             budget.tighten(np.flatnonzero(worst > max_error), 0.5 if best is None else 0.8)
+    if best is None and frames_only is not None:
+        # every frame holds, a half-frame does not (what keys at frames cannot mend, beyond
+        # the source's own bend between frames): kept, and said
+        warnings.warn(f"clip {clip.name!r}: halfway between frames the error reaches "
+                      f"{frames_only[3] * 100:.3g} cm over the source's own frames joined "
+                      f"straight, past the bound {max_error * 100:g} cm; every frame holds it",
+                      HalfFrameWarning)
+        best = frames_only[:3]
     if best is None:
         raise ValueError(f"clip {clip.name!r}: cannot hold max_error {max_error:g} m (still "
                          f"{err.max():.3g} m after {MAX_ATTEMPTS} encodes)")
     compressed, err, attempt = best
     return compressed, err, _row(clip, compressed, err, len(times), attempt, len(sources),
                                  skeleton)
+
+
+class HalfFrameWarning(UserWarning):
+    """A clip holds its bound at every frame but not halfway between two of them."""
+
+
+class HalfFrames:
+    """The check halfway between frames (a line over several frames of a fast swing strays
+    most there, and a cubic bends there).
+
+    What is held is the error the compressor adds: a joint's error at each half-frame less
+    the error there of the source's own frames joined by LERP / NLERP (``floor``, (H, J)),
+    which no key at a frame mends (a source that curves between its frames: a spline clip
+    checked at 30 Hz). For a source keyed at its frames with LINEAR or SLERP samplers the
+    floor is 0 (NLERP's midpoint is SLERP's).
+    """
+
+    def __init__(self, skeleton, clip, times, shell, mesh):
+        self.meter = ErrorMeter(skeleton, clip, half_frames(times), shell, mesh)
+        frames = sample_local(clip, times, skeleton)
+        joined = 0.5 * (frames[:-1] + frames[1:])          # u = 1/2: LERP, and NLERP below
+        q0, q1 = frames[:-1, :, 3:7], frames[1:, :, 3:7]
+        q1 = np.where(np.sum(q0 * q1, axis=-1, keepdims=True) < 0, -q1, q1)
+        q = q0 + q1
+        joined[..., 3:7] = q / np.linalg.norm(q, axis=-1, keepdims=True)
+        self.floor = self.meter.error_of_local(joined)
+
+    def excess(self, compressed):
+        """(J,) each joint's largest error over its floor at the half-frames."""
+        return np.maximum(self.meter.error(compressed) - self.floor, 0.0).max(axis=0)
+
+
+def _cubic_strays(skeleton, compressed, over, linear):
+    """Whether the clip's Catmull-Rom keys may be what takes the joints ``over`` (J,) bool past
+    the bound halfway between frames; if so, the joints with cubic keys on the path from each
+    of them to the root are marked in ``linear`` (J,) bool, to be encoded again with linear
+    keys (the reducer holds each cubic track to its share at the half-frames, but shares add
+    up in model space)."""
+    if not over.any() or isinstance(compressed, KeyedClip):
+        return False
+    cubic = np.zeros(len(skeleton), dtype=bool)
+    for tr in compressed.layout.animated:
+        cubic[tr.joint] |= tr.cubic
+    path = np.zeros(len(skeleton), dtype=bool)
+    for j in np.flatnonzero(over):
+        j = int(j)
+        while j >= 0:
+            path[j] = True
+            j = int(skeleton.parents[j])
+    mend = path & cubic & ~linear
+    linear |= mend
+    return bool(mend.any())
 
 
 def _row(clip, compressed, err, frames, attempts, sources, skeleton):
@@ -200,11 +276,14 @@ def _rigedit_clip(skeleton, clip, stored, uniform, grid, wide):
 def _gltf_clip(skeleton, clip, stored, uniform, grid, wide=False):
     tracks, kinds = {}, dict.fromkeys(("rotation", "translation", "scale", "times",
                                        "header"), 0)
+    seen = set()     # a list of key times is one accessor, shared (io/gltf_write_compact)
     for (j, channel), (times, values) in stored.items():
         tracks[(skeleton.names[j], channel)] = Track(channel, times.astype(np.float32),
                                                      values, _GLTF_MODE[channel])
         kinds[channel] += len(times) * (8 if channel == "rotation" else 12)
-        kinds["times"] += 4 * len(times)
+        key = times.astype(np.float32).tobytes()
+        kinds["times"] += 0 if key in seen else 4 * len(times)
+        seen.add(key)
     keyed = KeyedClip(Clip(clip.name, skeleton, tracks, clip.duration, clip.loop),
                       sum(kinds.values()))
     keyed.kinds = kinds
