@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
+from ..animation.track import Track
 from ..errors import RigFileError
 from .atomic import atomic_write
 from .data import as_rig_data
@@ -310,6 +311,15 @@ def clip_animation(w, rig, name, clip, joints, mesh_node, sampler):
                          "target": {"node": joints[clip.skeleton.index[joint]],
                                     "path": channel}})
     _weights_channel(w, rig, clip, mesh_node, samplers, channels)
+    if not channels:
+        # a clip of no tracks (the rest pose held): a glTF animation needs a channel, one
+        # without is dropped by readers and the clip would be lost; the root's rotation at
+        # its rest over the clip's duration keeps it and its length
+        sk = clip.skeleton
+        times = [0.0, clip.duration] if clip.duration > 0 else [0.0]
+        rest = Track("rotation", times, np.tile(sk.rest_rotation[0], (len(times), 1)), "slerp")
+        samplers.append(sampler(w, rest))
+        channels.append({"sampler": 0, "target": {"node": joints[0], "path": "rotation"}})
     if channels:
         w.add("animations", {"name": name, "samplers": samplers, "channels": channels,
                              "extras": {"rigedit": {"duration": clip.duration,

@@ -255,3 +255,20 @@ def test_six_distinct_influences_write_two_sets(tmp_path):
     back = load_gltf(out)
     assert_same_rig(rig, back)
     check_structure(out)
+
+
+@pytest.mark.parametrize("duration", [1.5, 0.0])
+def test_a_clip_of_no_tracks_is_kept_with_its_length(tmp_path, duration):
+    rig = rigedit.load_rig("humanoid")
+    rig.clips["still"] = Clip("still", rig.skeleton, {}, duration, False)
+    out = save_gltf(rig, tmp_path / "out.glb")
+    back = rigedit.load_rig(out)
+    assert sorted(back.clips) == sorted(rig.clips)
+    still = back.clips["still"]
+    assert still.duration == pytest.approx(duration)
+    pose = still.sample(0.5 * duration)
+    np.testing.assert_allclose(pose.as_array(), back.rest_pose().as_array(), atol=1e-6)
+    if os.environ.get("RIGEDIT_GLTF_VALIDATOR"):
+        run = subprocess.run(["node", _validator(), str(out)], capture_output=True, text=True,
+                             timeout=120)
+        assert json.loads(run.stdout)["issues"]["numErrors"] == 0
