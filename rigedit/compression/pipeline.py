@@ -183,8 +183,9 @@ def _compress_one(skeleton, clip, max_error, distances, target, shell, mesh):
                       HalfFrameWarning)
         best = frames_only[:3]
     if best is None:
-        raise ValueError(f"clip {clip.name!r}: cannot hold max_error {max_error:g} m (still "
-                         f"{err.max():.3g} m after {MAX_ATTEMPTS} encodes)")
+        raise ValueError(f"clip {clip.name!r}: cannot hold max_error {max_error:g} m "
+                         f"({max_error * 100:g} cm; still {err.max() * 100:.3g} cm after "
+                         f"{MAX_ATTEMPTS} encodes)")
     compressed, err, attempt = best
     return compressed, err, _row(clip, compressed, err, len(times), attempt, len(sources),
                                  skeleton)

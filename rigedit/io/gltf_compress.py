@@ -106,8 +106,9 @@ def _float_fallback(meter, name, clip, max_error, attempts):
     keys = slerp_keys(clip)
     err = meter.error(as_read(keys, float_rotations=True))
     if err.max() > max_error:
-        raise ValueError(f"clip {name!r}: cannot hold max_error {max_error:g} m in glTF (its "
-                         f"own keys with float32 rotations err {err.max():.3g} m)")
+        raise ValueError(f"clip {name!r}: cannot hold max_error {max_error:g} m "
+                         f"({max_error * 100:g} cm) in glTF (its own keys with float32 "
+                         f"rotations err {err.max() * 100:.3g} cm)")
     warnings.warn(f"clip {name!r}: glTF's int16 rotations alone err more than "
                   f"{max_error * 100:g} cm on this skeleton: its keys are written uncompressed "
                   "with float32 rotations (rigedit's own format compresses it)")
