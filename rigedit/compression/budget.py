@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["reach", "path_lengths", "model_scale", "Budget"]
+__all__ = ["reach", "path_lengths", "model_scale", "with_ancestors", "Budget"]
 
 
 def model_scale(skeleton):
@@ -49,6 +49,17 @@ def path_lengths(skeleton):
         if p >= 0:
             below[p] = max(below[p], below[j] + 1)
     return skeleton.depth + 1 + below
+
+
+def with_ancestors(skeleton, joints):
+    """(J,) bool: ``joints`` and every joint on their paths to the root."""
+    hit = np.zeros(len(skeleton), dtype=bool)
+    for j in np.atleast_1d(joints):
+        j = int(j)
+        while j >= 0 and not hit[j]:
+            hit[j] = True
+            j = int(skeleton.parents[j])
+    return hit
 
 
 class Budget:
@@ -103,11 +114,6 @@ class Budget:
 
     def tighten(self, joints, by=0.5):
         """Scale the share of ``joints`` and all their ancestors by ``by``."""
-        hit = np.zeros(len(self.skeleton), dtype=bool)
-        for j in np.atleast_1d(joints):
-            j = int(j)
-            while j >= 0 and not hit[j]:
-                hit[j] = True
-                j = int(self.skeleton.parents[j])
+        hit = with_ancestors(self.skeleton, joints)
         self.factor[hit] *= by
         return hit

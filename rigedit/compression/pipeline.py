@@ -19,15 +19,16 @@ from ..animation.clip import Clip
 from ..animation.track import Track
 from ..model.pose import Pose
 from ..progress import adapt
-from .budget import Budget
+from .budget import Budget, with_ancestors
 from .compressed_clip import CompressedClip, KeyedClip
 from .encode import encode_tracks, gltf_tracks
 from .constant import spread
 from .error import ErrorMeter
 from .kernels import load
-from .frames import COLUMNS, frame_times, sample_local
+from .frames import COLUMNS, frame_times
 from .layout import ClipLayout, grid_times, key_code, write_clip
 from .quantise import PER_KEY, SEGMENT, SEGMENT_HEADER_BITS
+from .cubic import align_to
 from .reduce_cubic import half_frames
 from .report import RAW_BYTES_PER_JOINT_FRAME, ClipRow, CompressionReport
 from .virtual import DEFAULT_SHELL, check_shell, shell_distances
@@ -133,7 +134,7 @@ def _compress_one(skeleton, clip, max_error, distances, target, shell, mesh):
     budget = Budget(skeleton, max_error, distances)
     uniform, grid, wide = _grid(times, target)
     ref = meter.local
-    halves = HalfFrames(skeleton, clip, times, shell, mesh) if len(times) > 1 else None
+    halves = HalfFrames(meter, clip, shell, mesh) if len(times) > 1 else None
     rest = Pose(skeleton).as_array()
     sources = [(skeleton.index[name], channel) for name, channel in clip.tracks]
     cache = {}
@@ -206,13 +207,14 @@ class HalfFrames:
     floor is 0 (NLERP's midpoint is SLERP's).
     """
 
-    def __init__(self, skeleton, clip, times, shell, mesh):
-        self.meter = ErrorMeter(skeleton, clip, half_frames(times), shell, mesh)
-        frames = sample_local(clip, times, skeleton)
-        joined = 0.5 * (frames[:-1] + frames[1:])          # u = 1/2: LERP, and NLERP below
-        q0, q1 = frames[:-1, :, 3:7], frames[1:, :, 3:7]
-        q1 = np.where(np.sum(q0 * q1, axis=-1, keepdims=True) < 0, -q1, q1)
-        q = q0 + q1
+    def __init__(self, frames, clip, shell, mesh):
+        """``frames``: the :class:`ErrorMeter` of the clip's frames (its source poses are
+        what is joined)."""
+        self.meter = ErrorMeter(frames.skeleton, clip, half_frames(frames.times), shell, mesh)
+        local = frames.local
+        joined = 0.5 * (local[:-1] + local[1:])            # u = 1/2: LERP, and NLERP below
+        q0 = local[:-1, :, 3:7]
+        q = q0 + align_to(local[1:, :, 3:7], q0)
         joined[..., 3:7] = q / np.linalg.norm(q, axis=-1, keepdims=True)
         self.floor = self.meter.error_of_local(joined)
 
@@ -232,13 +234,7 @@ def _cubic_strays(skeleton, compressed, over, linear):
     cubic = np.zeros(len(skeleton), dtype=bool)
     for tr in compressed.layout.animated:
         cubic[tr.joint] |= tr.cubic
-    path = np.zeros(len(skeleton), dtype=bool)
-    for j in np.flatnonzero(over):
-        j = int(j)
-        while j >= 0:
-            path[j] = True
-            j = int(skeleton.parents[j])
-    mend = path & cubic & ~linear
+    mend = with_ancestors(skeleton, np.flatnonzero(over)) & cubic & ~linear
     linear |= mend
     return bool(mend.any())
 

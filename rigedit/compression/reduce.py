@@ -23,9 +23,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .cubic import neighbour_keys
 from .kernels import load
 
-__all__ = ["MID_CHECK_ARC3", "interpolate_kept", "reduce_keys"]
+__all__ = ["MID_CHECK_ARC3", "interpolate_kept", "reduce_keys", "track_error"]
 
 #: A rotation span's half-frames are measured when its quaternion arc cubed exceeds this many
 #: of its track's tolerance (module notes).
@@ -61,7 +62,9 @@ def interpolate_kept(times, values, keep, rotation):
     return a + (b - a) * u[..., None]
 
 
-def _error(interp, reference, rotation):
+def track_error(interp, reference, rotation):
+    """Distance (...) of values (..., C) from the reference (quaternions: from the nearer of
+    it and its negative, the same rotation)."""
     d = np.linalg.norm(interp - reference, axis=-1)
     if rotation:
         d = np.minimum(d, np.linalg.norm(interp + reference, axis=-1))
@@ -71,11 +74,7 @@ def _error(interp, reference, rotation):
 def _interpolate_at(times, values, keep, rotation, at):
     """Each track's LERP / NLERP of its kept keys at times ``at`` (H,), ``at[g]`` inside frame
     interval ``[g, g + 1]``: (T, H, C), and the key frames of each one's span (T, H) x 2."""
-    t, f = keep.shape
-    index = np.arange(f)
-    prev = np.maximum.accumulate(np.where(keep, index, 0), axis=1)[:, :-1]
-    nxt = np.minimum.accumulate(np.where(keep, index, f - 1)[:, ::-1], axis=1)[:, ::-1]
-    nxt = nxt[:, 1:]
+    prev, nxt = (i[:, :-1] for i in neighbour_keys(keep)[1:3])
     t0, t1 = times[prev], times[nxt]
     u = (at[None] - t0) / np.where(t1 > t0, t1 - t0, 1.0)
     a = np.take_along_axis(values, prev[..., None], axis=1)
@@ -111,7 +110,7 @@ def reduce_keys(times, reference, values, tol, rotation, compiled=True, mid_refe
     -------
     keep : (T, F) bool
         Always the first and the last frame; a track whose quantised values already miss the
-        tolerance at a frame keeps every frame (the caller sees it in :func:`_error`).
+        tolerance at a frame keeps every frame (the caller sees it in :func:`track_error`).
     """
     t, f = reference.shape[:2]
     keep = np.zeros((t, f), dtype=bool)
@@ -136,13 +135,13 @@ def reduce_keys(times, reference, values, tol, rotation, compiled=True, mid_refe
     tol = np.asarray(tol, dtype=np.float64)[:, None]
     index = np.arange(f)
     for _ in range(f):
-        err = _error(interpolate_kept(times, values, keep, rotation), reference, rotation)
+        err = track_error(interpolate_kept(times, values, keep, rotation), reference, rotation)
         err[keep] = 0.0
         frame = np.broadcast_to(index, keep.shape)
         span = np.maximum.accumulate(np.where(keep, index, 0), axis=1)
         if len(mids):
             mid, a, b = _interpolate_at(times, values, keep, rotation, mids)
-            mid_err = _error(mid, mid_reference, rotation)
+            mid_err = track_error(mid, mid_reference, rotation)
             at = np.where(index[None, :-1] > a, index[None, :-1], index[None, 1:])
             dot = np.abs(np.sum(np.take_along_axis(values, a[..., None], axis=1)
                                 * np.take_along_axis(values, b[..., None], axis=1), axis=-1))

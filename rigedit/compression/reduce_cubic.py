@@ -18,6 +18,7 @@ import numpy as np
 
 from .cubic import hermite_cr, interpolate_cubic, neighbour_keys
 from .kernels import load
+from .reduce import track_error
 
 __all__ = ["half_frames", "reduce_cubic"]
 
@@ -26,13 +27,6 @@ def half_frames(times):
     """The times halfway between consecutive frames, (F - 1,)."""
     times = np.asarray(times, dtype=np.float64)
     return 0.5 * (times[:-1] + times[1:])
-
-
-def _distance(q, ref, rotation):
-    d = np.linalg.norm(q - ref, axis=-1)
-    if rotation:
-        d = np.minimum(d, np.linalg.norm(q + ref, axis=-1))
-    return d
 
 
 def reduce_cubic(times, reference, values, tol, rotation, mid_reference, compiled=True):
@@ -80,14 +74,14 @@ def reduce_cubic(times, reference, values, tol, rotation, mid_reference, compile
     tol = np.asarray(tol, dtype=np.float64)[:, None]
     index = np.arange(f)
     for _ in range(2 * f):
-        frame_err = _distance(interpolate_cubic(times, values, keep, rotation), reference,
+        frame_err = track_error(interpolate_cubic(times, values, keep, rotation), reference,
                               rotation)
         frame_err[keep] = 0.0
         i0, i1, i2, i3 = (i[:, :-1] for i in neighbour_keys(keep))
         take = [np.take_along_axis(values, i[..., None], axis=1) for i in (i0, i1, i2, i3)]
         mid = hermite_cr(times[i0], times[i1], times[i2], times[i3], *take,
                          np.broadcast_to(mids, i1.shape), rotation)
-        mid_err = _distance(mid, mid_reference, rotation)
+        mid_err = track_error(mid, mid_reference, rotation)
         # the frame a bad half-frame asks for: its left frame, or its right one when the left
         # is the span's first key; none when both are keys
         at = np.where(index[None, :-1] > i1, index[None, :-1], index[None, 1:])
