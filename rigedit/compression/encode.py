@@ -34,12 +34,25 @@ def _classified(values, rest, tol, rotation, measured=None):
     return kind, value
 
 
-def _groups(animated):
-    """Indices of ``animated`` by kind: rotations, then vectors (those there are)."""
+def _groups(animated, among=None):
+    """Indices of ``animated`` (of those in ``among``, all by default) by kind: rotations,
+    then vectors (those there are)."""
+    among = range(len(animated)) if among is None else among
     for rotation in (True, False):
-        group = [i for i, a in enumerate(animated) if a[3] == rotation]
+        group = [i for i in among if animated[i][3] == rotation]
         if group:
             yield rotation, group
+
+
+def _stacked(animated, group):
+    """The reducers' arrays of tracks ``group``: references (T, F, C), decoded values
+    (T, F, C), tolerances (T,) and the half-frame references (T, F - 1, C), None unless every
+    track has them."""
+    mids = [animated[i][4] if len(animated[i]) > 4 else None for i in group]
+    return (np.stack([animated[i][0] for i in group]),
+            np.stack([animated[i][1] for i in group]),
+            np.array([animated[i][2] for i in group]),
+            None if any(m is None for m in mids) else np.stack(mids))
 
 
 def _reduce_groups(grid, animated):
@@ -49,12 +62,8 @@ def _reduce_groups(grid, animated):
     each."""
     keys = [None] * len(animated)
     for rotation, group in _groups(animated):
-        mids = [animated[i][4] if len(animated[i]) > 4 else None for i in group]
-        keep = reduce_keys(grid, np.stack([animated[i][0] for i in group]),
-                           np.stack([animated[i][1] for i in group]),
-                           np.array([animated[i][2] for i in group]), rotation,
-                           mid_reference=None if any(m is None for m in mids)
-                           else np.stack(mids))
+        ref, decoded, tol, mids = _stacked(animated, group)
+        keep = reduce_keys(grid, ref, decoded, tol, rotation, mid_reference=mids)
         for row, i in zip(keep, group):
             keys[i] = np.flatnonzero(row)
     return keys
@@ -73,12 +82,9 @@ def _fewest_keys(grid, animated, allow):
         return out
     tried = [i for i, a in enumerate(animated) if len(a) > 4 and a[4] is not None
              and allow[i]]
-    for rotation, sub in _groups([animated[i] for i in tried]):
-        group = [tried[i] for i in sub]
-        keep, ok = reduce_cubic(grid, np.stack([animated[i][0] for i in group]),
-                                np.stack([animated[i][1] for i in group]),
-                                np.array([animated[i][2] for i in group]), rotation,
-                                np.stack([animated[i][4] for i in group]))
+    for rotation, group in _groups(animated, tried):
+        ref, decoded, tol, mids = _stacked(animated, group)
+        keep, ok = reduce_cubic(grid, ref, decoded, tol, rotation, mids)
         for row, good, i in zip(keep, ok, group):
             cubic = np.flatnonzero(row)
             if good and len(cubic) < len(linear[i]):
