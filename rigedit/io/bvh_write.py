@@ -78,6 +78,25 @@ def bvh_frame_times(clip, fps=None):
     return np.arange(count) * dt, dt
 
 
+class BvhFramesWarning(UserWarning):
+    """A clip's keys are on no frame rate BVH can hold: they are sampled at the frames."""
+
+
+def _warn_keys_between_frames(clip, times, dt, path):
+    """Say so, in one warning, when the frame rate :func:`bvh_frame_times` fell back to leaves
+    key times between frames (a BVH holds frames, not keys: those keys are sampled)."""
+    if clip is None or not clip.tracks:
+        return
+    keys = np.unique(np.concatenate([tr.times for tr in clip.tracks.values()]))
+    k = np.clip(np.round(keys / dt), 0, len(times) - 1).astype(int)
+    off = np.abs(times[k] - keys) > 1e-4 * dt
+    if off.any():
+        warnings.warn(f"{path}: {int(off.sum())} of {len(keys)} key times fall between the "
+                      f"{1 / dt:g} fps frames written (the keys are on no regular grid of at "
+                      f"most {MAX_KEY_RATE:g} fps); the clip is sampled there, those keys are "
+                      f"not kept as keys (save_bvh's fps= chooses the rate)", BvhFramesWarning)
+
+
 def _model_frames(skeleton, clip, times):
     """(F, J, 4, 4) model matrices of the clip at ``times`` (the rest pose when no clip)."""
     if clip is None:
@@ -173,6 +192,8 @@ def save_bvh(rig, path, clip=None, fps=None, units_per_metre=100.0, order=None):
     sk = rig.skeleton
     orders = _orders(sk.names, rig.meta.rotation_orders if order is None else {}, order)
     times, dt = bvh_frame_times(clip, fps)
+    if fps is None:
+        _warn_keys_between_frames(clip, times, dt, path)
     local_rot, local_t, _, frame_pos = _local_parts(_model_frames(sk, clip, times),
                                                     sk.parents)
     _warn_unless_human(frame_pos, sk.parents, float(units_per_metre), path)

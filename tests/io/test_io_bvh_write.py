@@ -9,7 +9,7 @@ from builders import chain_skeleton
 from rigedit.animation import Clip, Track
 from rigedit.cli.main import main
 from rigedit.io.bvh import load_bvh
-from rigedit.io.bvh_write import bvh_frame_times, save_bvh
+from rigedit.io.bvh_write import BvhFramesWarning, bvh_frame_times, save_bvh
 from rigedit.model import Skeleton
 from rigedit.model.transforms import euler_to_quat
 from rigedit.rig import Rig
@@ -209,7 +209,7 @@ def test_writing_a_figure_that_is_not_human_sized_warns(tmp_path):
         save_bvh(giant, tmp_path / "giant.bvh")
 
 
-def test_keys_nudged_together_are_not_taken_for_a_capture_rate():
+def test_keys_nudged_together_are_not_taken_for_a_capture_rate(tmp_path):
     # keys at 30 fps frames and one stopped 1e-4 s from its neighbour (a graph drag): every
     # key on a 1e-4 s grid, which is no frame rate (2 s would be 20,001 BVH frames)
     sk = Skeleton(["a", "b"], [-1, 0], [[0, 0, 0], [0, 1, 0]])
@@ -218,6 +218,12 @@ def test_keys_nudged_together_are_not_taken_for_a_capture_rate():
     clip = Clip("take", sk, {("b", "rotation"): Track("rotation", t, q)}, duration=2.0)
     times, dt = bvh_frame_times(clip)
     assert dt == pytest.approx(1 / 30) and len(times) == 61
+    # and the writer says the off-frame key is sampled, in one warning naming the file
+    rig = Rig(sk, np.zeros((0, 3)), np.zeros((0, 3), int), np.zeros((0, 1), int),
+              np.zeros((0, 1)), {"take": clip})
+    with pytest.warns(BvhFramesWarning, match=r"nudged.bvh: 1 of 5 key times fall between "
+                                               r"the 30 fps"):
+        save_bvh(rig, tmp_path / "nudged.bvh", units_per_metre=1.0)
     # a real 120 Hz capture keeps its rate
     t120 = np.arange(241) / 120.0
     clip = Clip("take", sk, {("b", "rotation"): Track("rotation", t120, np.tile(q[:1], (241, 1)))})
